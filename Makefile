@@ -1,0 +1,42 @@
+# Two commands do everything on a fresh Debian bookworm machine:
+#   make demo   set up, build, run the demo and print its report
+#   make test   set up, build, run every gtest, pytest and rostest; fails if any test fails
+# `make bench` runs the benchmarks. The catkin workspace lives in .ws/ around a link to this checkout.
+SHELL := /bin/bash
+.SHELLFLAGS := -eo pipefail -c
+# ROS runs on Debian's /usr/bin/python3; another python3 may come first on PATH.
+export PATH := /usr/bin:/bin:$(PATH)
+export ROS_HOME ?= $(CURDIR)/.ws/ros_home
+export PYTHONDONTWRITEBYTECODE := 1
+
+WS := $(CURDIR)/.ws
+PKG := mbot_slam_navigation
+JOBS ?= 2
+SOURCE := source $(WS)/devel/setup.bash
+
+.PHONY: setup build test demo bench clean
+
+setup:
+	@tools/setup_deps.sh
+	@mkdir -p $(WS)/src $(ROS_HOME)
+	@[ -L $(WS)/src/$(PKG) ] || ln -sfn $(CURDIR) $(WS)/src/$(PKG)
+
+build: setup
+	cd $(WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 > $(WS)/build.log 2>&1 \
+	  || { tail -n 60 $(WS)/build.log; echo "build failed: full log in $(WS)/build.log"; exit 1; }
+	@echo "build: ok (log in $(WS)/build.log)"
+
+test: build
+	cd $(WS) && catkin_make -j$(JOBS) tests > $(WS)/build-tests.log 2>&1 \
+	  || { tail -n 60 $(WS)/build-tests.log; echo "test build failed: $(WS)/build-tests.log"; exit 1; }
+	cd $(WS) && $(SOURCE) && catkin_make -j1 run_tests 2>&1 | tee $(WS)/run-tests.log | grep -E '^\[ *(ROSTEST|OK|FAIL|RUN|PASSED)|^(FAILURE|ERROR|SUMMARY)|passed|failed' || true
+	cd $(WS) && catkin_test_results --verbose build/test_results
+
+demo: build
+	cd $(WS) && $(SOURCE) && roslaunch $(PKG) smoke.launch report:=true
+
+bench: build
+	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/bench/run_all.py
+
+clean:
+	rm -rf $(WS)/build $(WS)/devel

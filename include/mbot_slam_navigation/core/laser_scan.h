@@ -1,0 +1,23 @@
+// A planar laser scan without ROS types: the fields of sensor_msgs/LaserScan the core needs.
+#pragma once
+
+#include <vector>
+
+namespace mbot {
+namespace core {
+
+/// Beams are counter-clockwise from angle_min in the sensor frame (REP 103). Ranges follow REP 117:
+/// +inf means no return within range_max, -inf an object closer than range_min, NaN an invalid beam.
+struct LaserScan {
+  double angle_min_rad = 0.0;
+  double angle_increment_rad = 0.0;
+  double range_min_m = 0.0;
+  double range_max_m = 0.0;
+  std::vector<float> ranges_m;
+
+  /// Angle of beam i in the sensor frame [rad].
+  double beamAngle(std::size_t i) const { return angle_min_rad + static_cast<double>(i) * angle_increment_rad; }
+};
+
+}  // namespace core
+}  // namespace mbot

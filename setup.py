@@ -1,0 +1,8 @@
+# Used by catkin_python_setup() only; do not run directly.
+from setuptools import setup
+from catkin_pkg.python_setup import generate_distutils_setup
+
+setup(**generate_distutils_setup(
+    packages=['mbot_slam_navigation'],
+    package_dir={'': 'src'},
+))

@@ -1,0 +1,37 @@
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "../../../src/nodes/ros_conversions.h"
+
+TEST(RosConversions, ScanKeepsRep117Ranges) {
+  sensor_msgs::LaserScan msg;
+  msg.angle_min = -1.0f;
+  msg.angle_increment = 0.5f;
+  msg.range_min = 0.1f;
+  msg.range_max = 5.0f;
+  msg.ranges = {1.0f, std::numeric_limits<float>::infinity(), 2.0f};
+  const auto scan = mbot::ros_glue::fromRos(msg);
+  EXPECT_DOUBLE_EQ(scan.beamAngle(2), 0.0);
+  EXPECT_TRUE(std::isinf(scan.ranges_m[1]));
+  EXPECT_TRUE(mbot::ros_glue::describeScanProblem(msg).empty());
+  msg.range_max = 0.0f;
+  EXPECT_NE(mbot::ros_glue::describeScanProblem(msg).find("range_max"), std::string::npos);
+  msg.ranges.clear();
+  EXPECT_NE(mbot::ros_glue::describeScanProblem(msg).find("no beams"), std::string::npos);
+}
+
+TEST(RosConversions, GridInfoAndData) {
+  mbot::core::OccupancyGrid grid(4, 3, 0.5, {-1.0, 2.0});
+  grid.setLogOdds({1, 2}, 5.0f);
+  nav_msgs::OccupancyGrid msg;
+  mbot::ros_glue::toRos(grid, msg);
+  EXPECT_EQ(msg.info.width, 4u);
+  EXPECT_EQ(msg.info.height, 3u);
+  EXPECT_FLOAT_EQ(msg.info.resolution, 0.5f);
+  EXPECT_DOUBLE_EQ(msg.info.origin.position.x, -1.0);
+  EXPECT_DOUBLE_EQ(msg.info.origin.orientation.w, 1.0);
+  ASSERT_EQ(msg.data.size(), 12u);
+  EXPECT_EQ(msg.data[2 * 4 + 1], 99);
+  EXPECT_EQ(msg.data[0], -1);
+}
