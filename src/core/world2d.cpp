@@ -1,0 +1,290 @@
+#include "mbot_slam_navigation/core/world2d.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace mbot {
+namespace core {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Ray p + t d (|d| = 1) against segment a-b: t >= 0 of the crossing, or +inf.
+double raySegment(const Eigen::Vector2d& p, const Eigen::Vector2d& d, const Eigen::Vector2d& a,
+                  const Eigen::Vector2d& b) {
+  const Eigen::Vector2d e = b - a;
+  const double denom = cross(d, e);
+  if (std::abs(denom) < 1e-15) return kInf;  // parallel: grazing contact is not a return
+  const Eigen::Vector2d ap = a - p;
+  const double t = cross(ap, e) / denom;
+  const double s = cross(ap, d) / denom;
+  return (t >= 0.0 && s >= 0.0 && s <= 1.0) ? t : kInf;
+}
+
+double rayCircle(const Eigen::Vector2d& p, const Eigen::Vector2d& d, const Eigen::Vector2d& c, double r) {
+  const Eigen::Vector2d m = p - c;
+  const double b = m.dot(d);
+  const double cc = m.squaredNorm() - r * r;
+  if (cc <= 0.0) return 0.0;  // starts inside
+  const double disc = b * b - cc;
+  if (disc < 0.0 || b > 0.0) return kInf;
+  return -b - std::sqrt(disc);
+}
+
+bool segmentsIntersect(const Eigen::Vector2d& p1, const Eigen::Vector2d& p2, const Eigen::Vector2d& q1,
+                       const Eigen::Vector2d& q2) {
+  const double d1 = cross(q2 - q1, p1 - q1), d2 = cross(q2 - q1, p2 - q1);
+  const double d3 = cross(p2 - p1, q1 - p1), d4 = cross(p2 - p1, q2 - p1);
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+  auto onSegment = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& q) {
+    return q.x() >= std::min(a.x(), b.x()) - 1e-12 && q.x() <= std::max(a.x(), b.x()) + 1e-12 &&
+           q.y() >= std::min(a.y(), b.y()) - 1e-12 && q.y() <= std::max(a.y(), b.y()) + 1e-12;
+  };
+  return (d1 == 0 && onSegment(q1, q2, p1)) || (d2 == 0 && onSegment(q1, q2, p2)) ||
+         (d3 == 0 && onSegment(p1, p2, q1)) || (d4 == 0 && onSegment(p1, p2, q2));
+}
+
+bool pointInPolygon(const Eigen::Vector2d& q, const Polygon& poly) {
+  bool inside = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Eigen::Vector2d& a = poly[i];
+    const Eigen::Vector2d& b = poly[j];
+    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+double pointSegmentDistance(const Eigen::Vector2d& q, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d e = b - a;
+  const double len2 = e.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((q - a).dot(e) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * e - q).norm();
+}
+
+bool polygonsOverlap(const Polygon& p, const Polygon& q) {
+  for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) {
+    for (std::size_t k = 0, l = q.size() - 1; k < q.size(); l = k++) {
+      if (segmentsIntersect(p[j], p[i], q[l], q[k])) return true;
+    }
+  }
+  return pointInPolygon(p[0], q) || pointInPolygon(q[0], p);
+}
+
+double rayPolygon(const Eigen::Vector2d& p, const Eigen::Vector2d& d, const Polygon& poly) {
+  double best = kInf;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) best = std::min(best, raySegment(p, d, poly[j], poly[i]));
+  return best;
+}
+
+}  // namespace
+
+World2D::World2D(double bucket_size_m) : bucket_(bucket_size_m) {
+  if (!(bucket_size_m > 0.0)) throw std::invalid_argument("World2D: bucket size must be positive");
+}
+
+void World2D::addSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  segments_.push_back({a, b});
+  dirty_ = true;
+}
+
+void World2D::addPolygon(const Polygon& polygon) {
+  if (polygon.size() < 3) throw std::invalid_argument("World2D: a polygon needs at least 3 vertices");
+  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) addSegment(polygon[j], polygon[i]);
+  solids_.push_back(polygon);
+}
+
+void World2D::addBox(const Eigen::Vector2d& center, double yaw_rad, double size_x_m, double size_y_m) {
+  if (!(size_x_m > 0.0 && size_y_m > 0.0)) throw std::invalid_argument("World2D: box sizes must be positive");
+  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+  Polygon box;
+  for (const auto& k : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
+    const Eigen::Vector2d local(0.5 * size_x_m * k.x(), 0.5 * size_y_m * k.y());
+    box.push_back(center + Eigen::Vector2d(c * local.x() - s * local.y(), s * local.x() + c * local.y()));
+  }
+  addPolygon(box);
+}
+
+void World2D::addCylinder(const Eigen::Vector2d& center, double radius_m) {
+  if (!(radius_m > 0.0)) throw std::invalid_argument("World2D: cylinder radius must be positive");
+  circles_.push_back({center, radius_m});
+  dirty_ = true;
+}
+
+void World2D::bucketRange(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int& x0, int& y0, int& x1,
+                          int& y1) const {
+  x0 = std::clamp(static_cast<int>(std::floor((lo.x() - lo_.x()) / bucket_)), 0, nx_ - 1);
+  y0 = std::clamp(static_cast<int>(std::floor((lo.y() - lo_.y()) / bucket_)), 0, ny_ - 1);
+  x1 = std::clamp(static_cast<int>(std::floor((hi.x() - lo_.x()) / bucket_)), 0, nx_ - 1);
+  y1 = std::clamp(static_cast<int>(std::floor((hi.y() - lo_.y()) / bucket_)), 0, ny_ - 1);
+}
+
+void World2D::rebuildIfNeeded() const {
+  if (!dirty_) return;
+  dirty_ = false;
+  lo_ = Eigen::Vector2d::Constant(kInf);
+  hi_ = Eigen::Vector2d::Constant(-kInf);
+  for (const Segment& s : segments_) {
+    lo_ = lo_.cwiseMin(s.a).cwiseMin(s.b);
+    hi_ = hi_.cwiseMax(s.a).cwiseMax(s.b);
+  }
+  for (const Circle& c : circles_) {
+    lo_ = lo_.cwiseMin(c.c - Eigen::Vector2d::Constant(c.r));
+    hi_ = hi_.cwiseMax(c.c + Eigen::Vector2d::Constant(c.r));
+  }
+  if (segments_.empty() && circles_.empty()) {
+    nx_ = ny_ = 0;
+    offsets_.assign(1, 0);
+    items_.clear();
+    return;
+  }
+  lo_ -= Eigen::Vector2d::Constant(1e-6);
+  hi_ += Eigen::Vector2d::Constant(1e-6);
+  nx_ = std::max(1, static_cast<int>(std::ceil((hi_.x() - lo_.x()) / bucket_)));
+  ny_ = std::max(1, static_cast<int>(std::ceil((hi_.y() - lo_.y()) / bucket_)));
+  std::vector<std::vector<int>> buckets(static_cast<std::size_t>(nx_) * ny_);
+  auto insert = [&](const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int item) {
+    int x0, y0, x1, y1;
+    bucketRange(lo, hi, x0, y0, x1, y1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) buckets[static_cast<std::size_t>(y) * nx_ + x].push_back(item);
+  };
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
+    insert(segments_[i].a.cwiseMin(segments_[i].b), segments_[i].a.cwiseMax(segments_[i].b), static_cast<int>(i));
+  }
+  for (std::size_t i = 0; i < circles_.size(); ++i) {
+    const Eigen::Vector2d r = Eigen::Vector2d::Constant(circles_[i].r);
+    insert(circles_[i].c - r, circles_[i].c + r, -1 - static_cast<int>(i));
+  }
+  offsets_.assign(buckets.size() + 1, 0);
+  items_.clear();
+  for (std::size_t k = 0; k < buckets.size(); ++k) {
+    items_.insert(items_.end(), buckets[k].begin(), buckets[k].end());
+    offsets_[k + 1] = static_cast<int>(items_.size());
+  }
+}
+
+double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double max_range_m, int skip_dynamic) const {
+  rebuildIfNeeded();
+  const Eigen::Vector2d d(std::cos(angle_rad), std::sin(angle_rad));
+  double best = kInf;
+  for (std::size_t i = 0; i < dynamic_.size(); ++i) {
+    if (static_cast<int>(i) != skip_dynamic) best = std::min(best, rayPolygon(origin, d, dynamic_[i]));
+  }
+  if (nx_ > 0) {
+    // Clip the ray to the grid's box (slab method).
+    double t0 = 0.0, t1 = max_range_m;
+    for (int k = 0; k < 2 && t0 <= t1; ++k) {
+      if (std::abs(d[k]) < 1e-15) {
+        if (origin[k] < lo_[k] || origin[k] > hi_[k]) t0 = kInf;
+      } else {
+        double ta = (lo_[k] - origin[k]) / d[k], tb = (hi_[k] - origin[k]) / d[k];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+      }
+    }
+    if (t0 <= t1) {
+      const Eigen::Vector2d start = origin + t0 * d;
+      int x = std::clamp(static_cast<int>(std::floor((start.x() - lo_.x()) / bucket_)), 0, nx_ - 1);
+      int y = std::clamp(static_cast<int>(std::floor((start.y() - lo_.y()) / bucket_)), 0, ny_ - 1);
+      const int step_x = d.x() > 0 ? 1 : -1, step_y = d.y() > 0 ? 1 : -1;
+      const double dt_x = std::abs(d.x()) > 1e-15 ? bucket_ / std::abs(d.x()) : kInf;
+      const double dt_y = std::abs(d.y()) > 1e-15 ? bucket_ / std::abs(d.y()) : kInf;
+      double next_x = std::abs(d.x()) > 1e-15
+                          ? (lo_.x() + (x + (step_x > 0 ? 1 : 0)) * bucket_ - origin.x()) / d.x()
+                          : kInf;
+      double next_y = std::abs(d.y()) > 1e-15
+                          ? (lo_.y() + (y + (step_y > 0 ? 1 : 0)) * bucket_ - origin.y()) / d.y()
+                          : kInf;
+      while (true) {
+        const int k = y * nx_ + x;
+        for (int j = offsets_[k]; j < offsets_[k + 1]; ++j) {
+          const int item = items_[j];
+          const double t = item >= 0 ? raySegment(origin, d, segments_[item].a, segments_[item].b)
+                                     : rayCircle(origin, d, circles_[-1 - item].c, circles_[-1 - item].r);
+          best = std::min(best, t);
+        }
+        const double exit = std::min(next_x, next_y);
+        if (best <= exit || exit > t1) break;
+        if (next_x < next_y) {
+          x += step_x;
+          next_x += dt_x;
+          if (x < 0 || x >= nx_) break;
+        } else {
+          y += step_y;
+          next_y += dt_y;
+          if (y < 0 || y >= ny_) break;
+        }
+      }
+    }
+  }
+  return best <= max_range_m ? best : kInf;
+}
+
+void World2D::castScan(const Eigen::Vector3d& sensor_pose, double angle_min_rad, double angle_increment_rad, int beams,
+                       double range_min_m, double range_max_m, double noise_stddev_m, double range_resolution_m,
+                       std::mt19937& rng, float* out, int skip_dynamic) const {
+  std::normal_distribution<double> noise(0.0, noise_stddev_m > 0.0 ? noise_stddev_m : 1.0);
+  const Eigen::Vector2d origin = sensor_pose.head<2>();
+  for (int i = 0; i < beams; ++i) {
+    double r = castRay(origin, sensor_pose.z() + angle_min_rad + i * angle_increment_rad, range_max_m, skip_dynamic);
+    if (std::isfinite(r)) {
+      if (noise_stddev_m > 0.0) r += noise(rng);
+      if (range_resolution_m > 0.0) r = std::round(r / range_resolution_m) * range_resolution_m;
+      if (r >= range_max_m) r = kInf;
+      else if (r < range_min_m) r = -kInf;
+    }
+    out[i] = static_cast<float>(r);
+  }
+}
+
+bool World2D::overlaps(const Polygon& polygon, int skip_dynamic) const {
+  rebuildIfNeeded();
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(kInf), hi = Eigen::Vector2d::Constant(-kInf);
+  for (const auto& v : polygon) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  for (std::size_t i = 0; i < dynamic_.size(); ++i) {
+    if (static_cast<int>(i) != skip_dynamic && polygonsOverlap(polygon, dynamic_[i])) return true;
+  }
+  if (nx_ > 0) {
+    int x0, y0, x1, y1;
+    bucketRange(lo, hi, x0, y0, x1, y1);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const int k = y * nx_ + x;
+        for (int j = offsets_[k]; j < offsets_[k + 1]; ++j) {
+          const int item = items_[j];
+          if (item >= 0) {
+            const Segment& s = segments_[item];
+            if (pointInPolygon(s.a, polygon)) return true;
+            for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
+              if (segmentsIntersect(polygon[b], polygon[a], s.a, s.b)) return true;
+            }
+          } else {
+            const Circle& c = circles_[-1 - item];
+            if (pointInPolygon(c.c, polygon)) return true;
+            for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
+              if (pointSegmentDistance(c.c, polygon[b], polygon[a]) < c.r) return true;
+            }
+          }
+        }
+      }
+    }
+  }
+  // Entirely inside a solid (no edge crossing): one vertex inside suffices.
+  for (const Polygon& s : solids_) {
+    if (pointInPolygon(polygon[0], s)) return true;
+  }
+  return false;
+}
+
+}  // namespace core
+}  // namespace mbot
