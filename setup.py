@@ -3,6 +3,6 @@ from setuptools import setup
 from catkin_pkg.python_setup import generate_distutils_setup
 
 setup(**generate_distutils_setup(
-    packages=['mbot_slam_navigation'],
+    packages=['mbot_slam_navigation', 'mbot_slam_navigation.sim'],
     package_dir={'': 'src'},
 ))

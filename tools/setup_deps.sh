@@ -20,3 +20,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq
   $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+# xacro is not in Debian's ROS: take it from PyPI for ROS's interpreter (scripts/xacro resolves
+# $(find) for ROS 1 around it).
+if ! /usr/bin/python3 -c 'import xacro' 2>/dev/null; then
+  echo "setup: installing xacro 2.1.1 from PyPI"
+  sudo=""; [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo /usr/bin/python3 -m pip install -q --break-system-packages --disable-pip-version-check xacro==2.1.1
+fi

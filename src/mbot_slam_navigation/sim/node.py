@@ -1,0 +1,302 @@
+"""gazebo_sim: the ROS face of the 2D simulator (stands in for gzserver + gazebo_ros plugins).
+
+Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible),
+step_size (0.01 s), pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false),
+odometry_slip_stddev (0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0),
+gazebo_namespace ("gazebo": where services and the contacts topic live).
+
+Publishes /clock; per robot (in its namespace): the drive's odometry topic and odom -> base tf,
+each laser's LaserScan, base_pose_ground_truth (nav_msgs/Odometry in the world frame). Services
+<ns>/spawn_urdf_model, delete_model, get_model_state, set_model_state, pause_physics,
+unpause_physics, reset_simulation, reset_world; topic <ns>/contacts (mbot_slam_navigation/Contact).
+Message stamps are simulated time; the node itself paces on the wall clock.
+"""
+import math
+import threading
+import time
+
+import numpy as np
+import rospy
+import tf2_ros
+from geometry_msgs.msg import Pose, Pose2D, TransformStamped, Twist
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty, EmptyResponse
+
+from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.sim.sdf_world import World, load_world
+from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
+from mbot_slam_navigation.sim.transforms import compose2d, quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.sim.urdf_robot import parse_urdf
+from mbot_slam_navigation.sim.xmlutil import XmlError
+from mbot_slam_navigation.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
+                                      SetModelState, SetModelStateResponse, SpawnModel, SpawnModelResponse)
+
+
+def _prefixed(namespace: str, frame: str) -> str:
+    """gazebo_ros's tf_prefix rule: frames of a namespaced robot are '<ns>/<frame>'."""
+    ns = namespace.strip('/')
+    return '%s/%s' % (ns, frame) if ns else frame
+
+
+def _pose_msg(x, y, yaw) -> Pose:
+    p = Pose()
+    p.position.x, p.position.y = x, y
+    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = yaw_to_quaternion(yaw)
+    return p
+
+
+class RobotIO:
+    """A spawned robot's publishers and subscriber."""
+
+    def __init__(self, node: 'SimNode', robot):
+        self.robot = robot
+        ns = robot.namespace.strip('/')
+        prefix = '/' + ns + '/' if ns else ''
+        drive = robot.spec.drive
+
+        def topic(name):
+            return name if name.startswith('/') else prefix + name
+
+        self.odom_frame = _prefixed(ns, drive.odometry_frame)
+        self.base_frame = _prefixed(ns, drive.robot_base_frame)
+        self.odom_pub = rospy.Publisher(topic(drive.odometry_topic), Odometry, queue_size=5)
+        self.truth_pub = rospy.Publisher(topic('base_pose_ground_truth'), Odometry, queue_size=5)
+        self.scan_pubs = [rospy.Publisher(topic(l.spec.topic), LaserScan, queue_size=5) for l in robot.lasers]
+        self.cmd_topic = topic(drive.command_topic)
+        self.cmd_sub = rospy.Subscriber(self.cmd_topic, Twist, node.on_cmd_vel, callback_args=robot.name, queue_size=5)
+
+    def close(self):
+        self.cmd_sub.unregister()
+        for p in [self.odom_pub, self.truth_pub] + self.scan_pubs:
+            p.unregister()
+
+
+class SimNode:
+    def __init__(self):
+        self.rtf = float(rospy.get_param('~real_time_factor', 1.0))
+        step = float(rospy.get_param('~step_size', 0.01))
+        clock_hz = float(rospy.get_param('~pub_clock_frequency', 100.0))
+        self.paused = bool(rospy.get_param('~paused', False))
+        self.gui = bool(rospy.get_param('~gui', False))
+        self.gz_ns = '/' + rospy.get_param('~gazebo_namespace', 'gazebo').strip('/')
+        world_path = rospy.get_param('~world_name', '')
+        if self.rtf < 0 or not clock_hz > 0:
+            raise ValueError('~real_time_factor must be >= 0 and ~pub_clock_frequency > 0 (got %r, %r)'
+                             % (self.rtf, clock_hz))
+        if world_path:
+            world = load_world(world_path)  # raises XmlError naming file and line
+        else:
+            world = World(name='empty')
+        for w in world.warnings:
+            rospy.logwarn('gazebo_sim: %s', w)
+        rospy.loginfo('gazebo_sim: world "%s" from %s: %d shapes', world.name, world_path or '(empty)',
+                      len(world.shapes))
+        self.sim = Simulation(world, step_size=step,
+                              slip_stddev=float(rospy.get_param('~odometry_slip_stddev', 0.02)),
+                              cmd_timeout=float(rospy.get_param('~cmd_vel_timeout', 0.5)),
+                              seed=int(rospy.get_param('~seed', 0)))
+        self.clock_period = 1.0 / clock_hz
+        self.next_clock = 0.0
+        self.lock = threading.RLock()
+        self.io = {}
+        self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=10)
+        self.contact_pub = rospy.Publisher(self.gz_ns + '/contacts', Contact, queue_size=20)
+        self.tf = tf2_ros.TransformBroadcaster()
+        s = self.gz_ns + '/'
+        rospy.Service(s + 'spawn_urdf_model', SpawnModel, self.on_spawn)
+        rospy.Service(s + 'delete_model', DeleteModel, self.on_delete)
+        rospy.Service(s + 'get_model_state', GetModelState, self.on_get_state)
+        rospy.Service(s + 'set_model_state', SetModelState, self.on_set_state)
+        rospy.Service(s + 'pause_physics', Empty, lambda _: self._set_paused(True))
+        rospy.Service(s + 'unpause_physics', Empty, lambda _: self._set_paused(False))
+        rospy.Service(s + 'reset_simulation', Empty, self.on_reset)
+        rospy.Service(s + 'reset_world', Empty, self.on_reset)
+        self.viewer = None
+        if self.gui:
+            from mbot_slam_navigation.sim.viewer import TopDownViewer
+            self.viewer = TopDownViewer(world)
+
+    # --- services and subscribers ---------------------------------------------------------------
+    def _set_paused(self, paused):
+        self.paused = paused
+        rospy.loginfo('gazebo_sim: physics %s', 'paused' if paused else 'running')
+        return EmptyResponse()
+
+    def on_spawn(self, req):
+        try:
+            spec = parse_urdf(req.model_xml, 'model_xml of "%s"' % req.model_name)
+            if req.reference_frame not in ('', 'world', 'map'):
+                raise SimulationError('reference_frame "%s": only the world frame is supported' % req.reference_frame)
+            q = req.initial_pose.orientation
+            yaw = quaternion_to_yaw(q.x, q.y, q.z, q.w) if (q.x, q.y, q.z, q.w) != (0, 0, 0, 0) else 0.0
+            with self.lock:
+                robot = self.sim.spawn(req.model_name, spec, (req.initial_pose.position.x, req.initial_pose.position.y,
+                                                              yaw), req.robot_namespace)
+                self.io[robot.name] = RobotIO(self, robot)
+        except (XmlError, SimulationError, ValueError) as e:
+            rospy.logerr('gazebo_sim: cannot spawn "%s": %s', req.model_name, e)
+            return SpawnModelResponse(False, 'SpawnModel: %s' % e)
+        for w in spec.warnings:
+            rospy.logwarn('gazebo_sim: %s', w)
+        io = self.io[robot.name]
+        rospy.loginfo('gazebo_sim: spawned "%s" (%s drive) at (%.2f, %.2f, %.2f rad), cmd on %s, lasers on %s',
+                      robot.name, spec.drive.kind, robot.pose[0], robot.pose[1], robot.pose[2], io.cmd_topic,
+                      ', '.join(p.resolved_name for p in io.scan_pubs) or 'none')
+        return SpawnModelResponse(True, 'SpawnModel: model "%s" spawned' % robot.name)
+
+    def on_delete(self, req):
+        try:
+            with self.lock:
+                self.sim.delete(req.model_name)
+                self.io.pop(req.model_name).close()
+        except SimulationError as e:
+            return DeleteModelResponse(False, 'DeleteModel: %s' % e)
+        return DeleteModelResponse(True, 'DeleteModel: "%s" deleted' % req.model_name)
+
+    def on_get_state(self, req):
+        res = GetModelStateResponse()
+        res.header.stamp = rospy.Time.from_sec(self.sim.time)
+        res.header.frame_id = req.relative_entity_name or 'world'
+        try:
+            with self.lock:
+                robot = self.sim.get(req.model_name)
+                pose = robot.pose
+                if req.relative_entity_name not in ('', 'world', 'map'):
+                    ref = self.sim.get(req.relative_entity_name).pose
+                    c, s = math.cos(ref[2]), math.sin(ref[2])
+                    dx, dy = pose[0] - ref[0], pose[1] - ref[1]
+                    pose = (c * dx + s * dy, -s * dx + c * dy, pose[2] - ref[2])
+                v, w = robot.drive.linear_velocity, robot.drive.angular_velocity
+        except SimulationError as e:
+            res.success, res.status_message = False, 'GetModelState: %s' % e
+            return res
+        res.pose = _pose_msg(*pose)
+        res.twist.linear.x, res.twist.linear.y = v * math.cos(robot.pose[2]), v * math.sin(robot.pose[2])
+        res.twist.angular.z = w
+        res.success, res.status_message = True, 'GetModelState: got properties'
+        return res
+
+    def on_set_state(self, req):
+        st = req.model_state
+        try:
+            if st.reference_frame not in ('', 'world', 'map'):
+                raise SimulationError('reference_frame "%s": only the world frame is supported' % st.reference_frame)
+            q = st.pose.orientation
+            with self.lock:
+                self.sim.set_pose(st.model_name, (st.pose.position.x, st.pose.position.y,
+                                                  quaternion_to_yaw(q.x, q.y, q.z, q.w)))
+        except SimulationError as e:
+            return SetModelStateResponse(False, 'SetModelState: %s' % e)
+        return SetModelStateResponse(True, 'SetModelState: set model state done')
+
+    def on_reset(self, _req):
+        with self.lock:
+            self.sim.reset()
+            self.next_clock = 0.0
+        rospy.loginfo('gazebo_sim: simulation reset')
+        return EmptyResponse()
+
+    def on_cmd_vel(self, msg, name):
+        with self.lock:
+            if name not in self.sim.robots:
+                return
+            if not self.sim.command(name, msg.linear.x, msg.angular.z):
+                rospy.logwarn_throttle(2.0, 'gazebo_sim: ignoring a non-finite command on %s (linear.x=%r, '
+                                       'angular.z=%r); "%s" keeps its previous command',
+                                       self.io[name].cmd_topic, msg.linear.x, msg.angular.z, name)
+
+    # --- the loop ---------------------------------------------------------------------------------
+    def publish_robot(self, io: RobotIO, stamp, due_odom: bool, due_lasers):
+        robot, sim = io.robot, self.sim
+        if due_odom:
+            ox, oy, oyaw = (float(v) for v in robot.drive.odom_pose)
+            v, w = robot.drive.linear_velocity, robot.drive.angular_velocity
+            odom = Odometry()
+            odom.header.stamp, odom.header.frame_id, odom.child_frame_id = stamp, io.odom_frame, io.base_frame
+            odom.pose.pose = _pose_msg(ox, oy, oyaw)
+            cx, cy, cyaw = robot.spec.drive.covariance
+            odom.pose.covariance[0], odom.pose.covariance[7], odom.pose.covariance[35] = cx, cy, cyaw
+            odom.twist.twist.linear.x, odom.twist.twist.angular.z = v, w
+            io.odom_pub.publish(odom)
+            truth = Odometry()
+            truth.header.stamp, truth.header.frame_id, truth.child_frame_id = stamp, 'world', io.base_frame
+            truth.pose.pose = _pose_msg(*robot.pose)
+            truth.twist.twist.linear.x, truth.twist.twist.angular.z = v, w
+            io.truth_pub.publish(truth)
+            if robot.spec.drive.publish_odom_tf:
+                t = TransformStamped()
+                t.header.stamp, t.header.frame_id, t.child_frame_id = stamp, io.odom_frame, io.base_frame
+                t.transform.translation.x, t.transform.translation.y = ox, oy
+                (t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z,
+                 t.transform.rotation.w) = yaw_to_quaternion(oyaw)
+                self.tf.sendTransform(t)
+        for k in due_lasers:
+            laser = robot.lasers[k]
+            s = laser.spec
+            scan = LaserScan()
+            scan.header.stamp = stamp
+            scan.header.frame_id = _prefixed(robot.namespace, s.frame_id)
+            scan.angle_min, scan.angle_max, scan.angle_increment = s.angle_min, s.angle_max, s.angle_increment
+            scan.scan_time = 1.0 / s.update_rate
+            scan.range_min, scan.range_max = s.range_min, s.range_max
+            scan.ranges = sim.scan(robot, laser).tolist()
+            io.scan_pubs[k].publish(scan)
+
+    def run(self):
+        wall0, sim0 = time.monotonic(), self.sim.time
+        last_viewer = 0.0
+        while not rospy.is_shutdown():
+            if self.paused:
+                time.sleep(0.01)
+                wall0, sim0 = time.monotonic(), self.sim.time
+                continue
+            with self.lock:
+                contacts = self.sim.step()
+                now = self.sim.time
+                stamp = rospy.Time.from_sec(now)
+                publish_clock = now + 1e-9 >= self.next_clock
+                if publish_clock:
+                    self.next_clock = now + self.clock_period
+                work = []
+                for io in self.io.values():
+                    r = io.robot
+                    due_odom = now + 1e-9 >= r.next_odom_time
+                    if due_odom:
+                        r.next_odom_time = now + 1.0 / r.spec.drive.update_rate
+                    due_lasers = []
+                    for k, laser in enumerate(r.lasers):
+                        if now + 1e-9 >= laser.next_time:
+                            laser.next_time = now + 1.0 / laser.spec.update_rate
+                            due_lasers.append(k)
+                    if due_odom or due_lasers:
+                        work.append((io, due_odom, due_lasers))
+                for io, due_odom, due_lasers in work:
+                    self.publish_robot(io, stamp, due_odom, due_lasers)
+            if publish_clock:
+                self.clock_pub.publish(Clock(clock=stamp))
+            for r in contacts:
+                rospy.logwarn('gazebo_sim: "%s" collided at (%.2f, %.2f); %d collisions so far',
+                              r.name, r.pose[0], r.pose[1], r.collisions)
+                c = Contact(model_name=r.name, pose=Pose2D(*r.pose), total_collisions=r.collisions)
+                c.header.stamp, c.header.frame_id = stamp, 'world'
+                self.contact_pub.publish(c)
+            if self.viewer is not None and time.monotonic() - last_viewer > 0.05:
+                last_viewer = time.monotonic()
+                with self.lock:
+                    self.viewer.draw(self.sim)
+            if self.rtf > 0:
+                ahead = (now - sim0) / self.rtf - (time.monotonic() - wall0)
+                if ahead > 0:
+                    time.sleep(ahead)
+
+
+def main():
+    rospy.init_node('gazebo_sim')
+    try:
+        node = SimNode()
+    except (XmlError, ValueError) as e:
+        rospy.logfatal('gazebo_sim: %s', e)
+        raise SystemExit(1)
+    node.run()
