@@ -1,25 +1,26 @@
 # Two commands do everything on a fresh Debian bookworm machine:
 #   make demo   set up, build, run the demo and print its report
 #   make test   set up, build, run every gtest, pytest and rostest; fails if any test fails
-# `make bench` runs the benchmarks. The catkin workspace lives in .ws/ around a link to this checkout.
+# `make bench` runs the benchmarks. The catkin workspace lives outside the checkout (WS, default
+# ~/.cache/mbot_slam_navigation_ws) around a link to it: a workspace inside the package would be
+# searched by rosrun and give every executable twice.
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
 # ROS runs on Debian's /usr/bin/python3; another python3 may come first on PATH.
 export PATH := /usr/bin:/bin:$(PATH)
-export ROS_HOME ?= $(CURDIR)/.ws/ros_home
+WS ?= $(HOME)/.cache/mbot_slam_navigation_ws
+export ROS_HOME ?= $(WS)/ros_home
 export PYTHONDONTWRITEBYTECODE := 1
-
-WS := $(CURDIR)/.ws
 PKG := mbot_slam_navigation
 JOBS ?= 2
 SOURCE := source $(WS)/devel/setup.bash
 
-.PHONY: setup build test demo bench clean
+.PHONY: setup build test demo bench clean print-ws
 
 setup:
 	@tools/setup_deps.sh
 	@mkdir -p $(WS)/src $(ROS_HOME)
-	@[ -L $(WS)/src/$(PKG) ] || ln -sfn $(CURDIR) $(WS)/src/$(PKG)
+	@[ "$$(readlink $(WS)/src/$(PKG))" = "$(CURDIR)" ] || ln -sfn $(CURDIR) $(WS)/src/$(PKG)
 
 build: setup
 	cd $(WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 > $(WS)/build.log 2>&1 \
@@ -40,3 +41,6 @@ bench: build
 
 clean:
 	rm -rf $(WS)/build $(WS)/devel
+
+print-ws:
+	@echo $(WS)

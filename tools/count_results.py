@@ -23,5 +23,5 @@ def count(results_dir):
 
 
 if __name__ == '__main__':
-    p, f = count(sys.argv[1] if len(sys.argv) > 1 else '.ws/build/test_results')
+    p, f = count(sys.argv[1])
     print('%d passed, %d failed' % (p, f))
