@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The simulator as a user sees it: driving, odometry, laser ranges, collisions, services."""
 import math
+import time
 import unittest
 
 import rospy
@@ -123,6 +124,18 @@ class SimHomeTest(unittest.TestCase):
         self.assertIn('no drive plugin', res.status_message)
         # The simulator still serves the first robot.
         self.assertTrue(self.get_state(model_name='robot').success)
+
+    def test_5_pause_stops_the_clock_and_unpause_resumes(self):
+        from rosgraph_msgs.msg import Clock
+        from std_srvs.srv import Empty
+        rospy.ServiceProxy('/gazebo/pause_physics', Empty)()
+        time.sleep(0.5)  # let a /clock already on its way arrive
+        t0 = rospy.get_rostime()
+        time.sleep(1.5)  # wall time: simulated time must not move while paused
+        self.assertEqual(rospy.get_rostime(), t0)
+        rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()
+        rospy.wait_for_message('/clock', Clock, timeout=5.0)
+        self.assertGreater(rospy.get_rostime(), t0)
 
 
 if __name__ == '__main__':

@@ -72,3 +72,19 @@ def test_shipped_robots_through_xacro():
     assert car.drive.kind == 'skid' and len(car.drive.wheel_joints) == 4
     assert car.lasers[0].topic == '/scan' and car.lasers[0].frame_id == 'hokuyo_link'
     assert np.allclose(car.footprint.max(axis=0), [0.2, 0.2], atol=0.01)
+
+
+def test_wheel_joints_for_publish_wheel_tf():
+    from mbot_slam_navigation.sim.transforms import from_xyz_rpy, matrix_to_quaternion, quaternion_multiply
+    mbot = parse_urdf(xacro(os.path.join(PKG, 'urdf', 'xacro', 'robot.xacro')))
+    left, right = mbot.wheels
+    assert (left.name, left.parent, left.child, left.side) == ('left_wheel_joint', 'base_link', 'left_wheel_link', 0)
+    assert right.side == 1 and right.origin[1, 3] == pytest.approx(-0.19)
+    assert np.allclose(left.axis, [0, 1, 0])
+    # Quaternion helpers agree with the matrices they stand for.
+    for rpy in ((0.3, -0.2, 2.5), (math.pi, 0, 0), (0, math.pi, 0.1), (0, 0, -math.pi)):
+        q = matrix_to_quaternion(from_xyz_rpy((0, 0, 0), rpy))
+        assert sum(c * c for c in q) == pytest.approx(1.0)
+    qz = matrix_to_quaternion(from_xyz_rpy((0, 0, 0), (0, 0, 0.4)))
+    q2 = quaternion_multiply(qz, qz)
+    assert q2 == pytest.approx(matrix_to_quaternion(from_xyz_rpy((0, 0, 0), (0, 0, 0.8))))

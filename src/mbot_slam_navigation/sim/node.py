@@ -16,7 +16,6 @@ import threading
 import time
 import warnings
 
-import numpy as np
 import rospy
 from geometry_msgs.msg import Pose, Pose2D, TransformStamped, Twist
 from nav_msgs.msg import Odometry
@@ -28,7 +27,8 @@ from tf2_msgs.msg import TFMessage
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.sim.sdf_world import World, load_world
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
-from mbot_slam_navigation.sim.transforms import compose2d, quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.sim.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
+                                                 yaw_to_quaternion)
 from mbot_slam_navigation.sim.urdf_robot import parse_urdf
 from mbot_slam_navigation.sim.xmlutil import XmlError
 from mbot_slam_navigation.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
@@ -240,13 +240,18 @@ class SimNode:
                 truth.pose.pose = _pose_msg(*robot.pose)
                 truth.twist.twist.linear.x, truth.twist.twist.angular.z = v, w
                 io.truth_pub.publish(truth)
+            transforms = []
             if robot.spec.drive.publish_odom_tf:
                 t = TransformStamped()
                 t.header.stamp, t.header.frame_id, t.child_frame_id = stamp, io.odom_frame, io.base_frame
                 t.transform.translation.x, t.transform.translation.y = ox, oy
                 (t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z,
                  t.transform.rotation.w) = yaw_to_quaternion(oyaw)
-                self.tf_pub.publish(TFMessage([t]))
+                transforms = [t]
+            if robot.spec.drive.publish_wheel_tf:
+                transforms += self.wheel_transforms(robot, stamp)
+            if transforms:
+                self.tf_pub.publish(TFMessage(transforms))
         for k in due_lasers:
             laser = robot.lasers[k]
             s = laser.spec
@@ -258,6 +263,24 @@ class SimNode:
             scan.range_min, scan.range_max = s.range_min, s.range_max
             scan.ranges = sim.scan(robot, laser).tolist()
             io.scan_pubs[k].publish(scan)
+
+    @staticmethod
+    def wheel_transforms(robot, stamp):
+        """publishWheelTF: each wheel link turned by its accumulated angle about its joint axis."""
+        out = []
+        angles = robot.drive.wheel_angles
+        for wheel in robot.spec.wheels:
+            half = 0.5 * float(angles[wheel.side])
+            spin = tuple(wheel.axis * math.sin(half)) + (math.cos(half),)
+            t = TransformStamped()
+            t.header.stamp = stamp
+            t.header.frame_id = _prefixed(robot.namespace, wheel.parent)
+            t.child_frame_id = _prefixed(robot.namespace, wheel.child)
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = wheel.origin[:3, 3]
+            (t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z,
+             t.transform.rotation.w) = quaternion_multiply(matrix_to_quaternion(wheel.origin), spin)
+            out.append(t)
+        return out
 
     def run(self):
         wall0, sim0 = time.monotonic(), self.sim.time

@@ -38,6 +38,33 @@ def quaternion_to_yaw(x: float, y: float, z: float, w: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
+def matrix_to_quaternion(t: np.ndarray) -> Tuple[float, float, float, float]:
+    """(x, y, z, w) of the rotation part of a 4x4 (or 3x3) matrix."""
+    r = np.asarray(t)[:3, :3]
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    if trace > 0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        q = ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, 0.25 * s)
+    else:  # pick the largest diagonal element for a stable square root
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
+        v = [0.0, 0.0, 0.0]
+        v[i] = 0.25 * s
+        v[j] = (r[j, i] + r[i, j]) / s
+        v[k] = (r[k, i] + r[i, k]) / s
+        q = (v[0], v[1], v[2], (r[k, j] - r[j, k]) / s)
+    return tuple(float(c) for c in q)
+
+
+def quaternion_multiply(a, b) -> Tuple[float, float, float, float]:
+    """Hamilton product a * b of (x, y, z, w) quaternions: rotate by b, then by a."""
+    x1, y1, z1, w1 = a
+    x2, y2, z2, w2 = b
+    return (w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2, w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2, w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2)
+
+
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull of 2D points (Andrew's monotone chain)."""
     pts = sorted(set(map(tuple, np.round(np.asarray(points, float), 9))))

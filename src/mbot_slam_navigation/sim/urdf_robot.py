@@ -77,12 +77,24 @@ class LaserSpec:
 
 
 @dataclass
+class WheelJoint:
+    """A driven wheel's joint, for publishWheelTF: parent -> child is origin, then a turn about axis."""
+    name: str
+    parent: str
+    child: str
+    origin: np.ndarray             # 4x4 joint origin in the parent link
+    axis: np.ndarray               # unit rotation axis in the joint frame
+    side: int                      # 0 left, 1 right
+
+
+@dataclass
 class RobotSpec:
     name: str
     drive: DriveSpec
     lasers: List[LaserSpec]
     footprint: np.ndarray          # (N, 2) convex polygon [m] in the robot base frame
     warnings: List[str] = field(default_factory=list)
+    wheels: List[WheelJoint] = field(default_factory=list)
 
 
 def _bool(text: str) -> bool:
@@ -124,7 +136,26 @@ def parse_urdf(text: str, source: str = 'robot_description') -> RobotSpec:
     laser_specs = [_read_laser(ref, s, base_inv, link_tf, source, lines, warnings) for ref, s in lasers]
     footprint = _footprint(links, link_tf, base_inv, source, lines, warnings)
     return RobotSpec(name=root.get('name', 'robot'), drive=drive, lasers=laser_specs, footprint=footprint,
-                     warnings=warnings)
+                     warnings=warnings, wheels=_wheel_joints(root, drive, source, lines, warnings))
+
+
+def _wheel_joints(root, drive: DriveSpec, source, lines, warnings) -> List[WheelJoint]:
+    joints = {j.get('name'): j for j in root.findall('joint')}
+    out = []
+    for k, name in enumerate(drive.wheel_joints):
+        j = joints.get(name)
+        if j is None:
+            warnings.append('%s: wheel joint "%s" named by the drive plugin is not in the URDF'
+                            % (where(source, lines, root), name))
+            continue
+        origin = j.find('origin')
+        xyz = floats(origin.get('xyz', '0 0 0'), 3, name) if origin is not None else [0, 0, 0]
+        rpy = floats(origin.get('rpy', '0 0 0'), 3, name) if origin is not None else [0, 0, 0]
+        axis_el = j.find('axis')
+        axis = np.array(floats(axis_el.get('xyz', '1 0 0'), 3, name) if axis_el is not None else [1, 0, 0])
+        out.append(WheelJoint(name=name, parent=j.find('parent').get('link'), child=j.find('child').get('link'),
+                              origin=from_xyz_rpy(xyz, rpy), axis=axis / np.linalg.norm(axis), side=k % 2))
+    return out
 
 
 def _link_transforms(root, links, source, lines) -> Dict[str, np.ndarray]:
