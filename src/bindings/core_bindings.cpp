@@ -10,6 +10,7 @@
 #include "mbot_slam_navigation/core/diff_drive.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
+#include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "mbot_slam_navigation/core/world2d.h"
 
 namespace py = pybind11;
@@ -173,4 +174,102 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("angular_velocity", &DiffDrive::angularVelocity)
       .def_property_readonly("wheel_angles", &DiffDrive::wheelAngles)
       .def("footprint_in_world", &DiffDrive::footprintInWorld);
+
+  // --- SLAM (offline tools and tests; the node is roscpp) --------------------------------------
+  py::class_<mbot::core::MotionModelParams>(m, "_MotionModelParams")
+      .def(py::init<>())
+      .def_readwrite("srr", &mbot::core::MotionModelParams::srr)
+      .def_readwrite("srt", &mbot::core::MotionModelParams::srt)
+      .def_readwrite("str", &mbot::core::MotionModelParams::str)
+      .def_readwrite("stt", &mbot::core::MotionModelParams::stt);
+  using mbot::core::ScanMatcherParams;
+  py::class_<ScanMatcherParams>(m, "_ScanMatcherParams")
+      .def(py::init<>())
+      .def_readwrite("sigma", &ScanMatcherParams::sigma)
+      .def_readwrite("kernel_size", &ScanMatcherParams::kernel_size)
+      .def_readwrite("lstep", &ScanMatcherParams::lstep)
+      .def_readwrite("astep", &ScanMatcherParams::astep)
+      .def_readwrite("iterations", &ScanMatcherParams::iterations)
+      .def_readwrite("lsigma", &ScanMatcherParams::lsigma)
+      .def_readwrite("lskip", &ScanMatcherParams::lskip)
+      .def_readwrite("max_urange", &ScanMatcherParams::max_urange)
+      .def_readwrite("max_range", &ScanMatcherParams::max_range)
+      .def_readwrite("laser_pose", &ScanMatcherParams::laser_pose);
+  using mbot::core::RbpfParams;
+  py::class_<RbpfParams>(m, "_RbpfParams")
+      .def(py::init<>())
+      .def_readwrite("particles", &RbpfParams::particles)
+      .def_readwrite("linear_update", &RbpfParams::linear_update)
+      .def_readwrite("angular_update", &RbpfParams::angular_update)
+      .def_readwrite("temporal_update", &RbpfParams::temporal_update)
+      .def_readwrite("resample_threshold", &RbpfParams::resample_threshold)
+      .def_readwrite("ogain", &RbpfParams::ogain)
+      .def_readwrite("minimum_score", &RbpfParams::minimum_score)
+      .def_readwrite("llsamplerange", &RbpfParams::llsamplerange)
+      .def_readwrite("llsamplestep", &RbpfParams::llsamplestep)
+      .def_readwrite("lasamplerange", &RbpfParams::lasamplerange)
+      .def_readwrite("lasamplestep", &RbpfParams::lasamplestep)
+      .def_readwrite("delta", &RbpfParams::delta)
+      .def_readwrite("xmin", &RbpfParams::xmin)
+      .def_readwrite("ymin", &RbpfParams::ymin)
+      .def_readwrite("xmax", &RbpfParams::xmax)
+      .def_readwrite("ymax", &RbpfParams::ymax)
+      .def_readwrite("seed", &RbpfParams::seed)
+      .def_readwrite("motion", &RbpfParams::motion)
+      .def_readwrite("matcher", &RbpfParams::matcher)
+      .def("validate", &RbpfParams::validate);
+  using mbot::core::RbpfSlam;
+  py::class_<RbpfSlam>(m, "_RbpfSlam")
+      .def(py::init<const RbpfParams&>())
+      .def(
+          "process_scan",
+          [](RbpfSlam& s, const Eigen::Vector3d& odom, double angle_min, double angle_increment, double range_min,
+             double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,
+             double time) {
+            const LaserScan scan = toScan(angle_min, angle_increment, range_min, range_max, ranges);
+            py::gil_scoped_release release;
+            return s.processScan(odom, scan, time);
+          },
+          py::arg("odom"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("range_min"),
+          py::arg("range_max"), py::arg("ranges"), py::arg("time"))
+      .def("current_pose", &RbpfSlam::currentPose)
+      .def("best_trajectory",
+           [](const RbpfSlam& s) {
+             const auto traj = s.bestTrajectory();
+             py::array_t<double> out({static_cast<py::ssize_t>(traj.size()), static_cast<py::ssize_t>(7)});
+             auto o = out.mutable_unchecked<2>();
+             for (std::size_t i = 0; i < traj.size(); ++i) {
+               o(i, 0) = traj[i].time_s;
+               for (int k = 0; k < 3; ++k) {
+                 o(i, 1 + k) = traj[i].pose[k];
+                 o(i, 4 + k) = traj[i].odom[k];
+               }
+             }
+             return out;
+           })
+      .def("best_map",
+           [](const RbpfSlam& s, double occ_thresh) {
+             const auto img = s.best().map.toOccupancy(occ_thresh);
+             py::array_t<int8_t> data({img.height, img.width});
+             std::copy(img.data.begin(), img.data.end(), data.mutable_data());
+             return py::make_tuple(data, img.origin, img.resolution);
+           },
+           py::arg("occ_thresh") = 0.25)
+      .def("pose_entropy", &RbpfSlam::poseEntropy)
+      .def_property_readonly("updates", &RbpfSlam::updates)
+      .def_property_readonly("resamples", &RbpfSlam::resamples)
+      .def_property_readonly("last_neff", &RbpfSlam::lastNeff)
+      .def("particle_poses", [](const RbpfSlam& s) {
+        std::vector<Eigen::Vector3d> out;
+        for (const auto& p : s.particles()) out.push_back(p.pose);
+        return out;
+      })
+      .def("shared_patch_stats", [](const RbpfSlam& s) {
+        long owned = 0, allocated = 0;
+        for (const auto& p : s.particles()) {
+          owned += p.map.ownedPatches();
+          allocated += p.map.allocatedPatches();
+        }
+        return py::make_tuple(owned, allocated);
+      });
 }

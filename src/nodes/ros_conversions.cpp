@@ -1,5 +1,6 @@
 #include "ros_conversions.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -36,8 +37,42 @@ std::string describeScanProblem(const sensor_msgs::LaserScan& msg) {
     why << "its angle_min/angle_increment (" << msg.angle_min << ", " << msg.angle_increment << ") are not usable";
   } else if (!std::isfinite(msg.range_max) || !(msg.range_max > msg.range_min)) {
     why << "its range_max (" << msg.range_max << ") is not above range_min (" << msg.range_min << ")";
+  } else if (std::isfinite(msg.angle_max)) {
+    const double announced = (msg.angle_max - msg.angle_min) / msg.angle_increment + 1.0;
+    if (std::abs(announced - static_cast<double>(msg.ranges.size())) > 1.5) {
+      why << "angle_min..angle_max announce " << std::lround(announced) << " beams but it has " << msg.ranges.size();
+    }
+  }
+  if (why.str().empty()) {
+    bool any = false;
+    for (float r : msg.ranges) any = any || (!std::isnan(r) && r >= msg.range_min);
+    if (!any) why << "none of its " << msg.ranges.size() << " ranges is usable (all NaN or below range_min)";
   }
   return why.str();
+}
+
+std::string nearestName(const std::string& name, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_d = std::string::npos;
+  for (const std::string& c : candidates) {
+    // Levenshtein distance, one row at a time.
+    std::vector<std::size_t> row(c.size() + 1);
+    for (std::size_t j = 0; j <= c.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= name.size(); ++i) {
+      std::size_t diag = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= c.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (name[i - 1] == c[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    if (row[c.size()] < best_d) {
+      best_d = row[c.size()];
+      best = c;
+    }
+  }
+  return best;
 }
 
 }  // namespace ros_glue

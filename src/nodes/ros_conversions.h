@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/LaserScan.h>
@@ -19,8 +20,12 @@ core::LaserScan fromRos(const sensor_msgs::LaserScan& msg);
 void toRos(const core::OccupancyGrid& grid, nav_msgs::OccupancyGrid& out);
 
 /// Empty when the scan's header and ranges are consistent, else a sentence saying what is wrong
-/// (NaN in the beam geometry, range_max <= range_min, no beams), for a warning naming the topic.
+/// (NaN or inf in the beam geometry, range_max <= range_min, no beams, fewer or more beams than
+/// angle_min..angle_max announce, no usable range at all), for a warning naming the topic.
 std::string describeScanProblem(const sensor_msgs::LaserScan& msg);
+
+/// The candidate closest to `name` by edit distance (for "unknown parameter, did you mean" warnings).
+std::string nearestName(const std::string& name, const std::vector<std::string>& candidates);
 
 }  // namespace ros_glue
 }  // namespace mbot

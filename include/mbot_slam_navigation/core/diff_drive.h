@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/world2d.h"
 
 namespace mbot {
@@ -65,13 +66,6 @@ class DiffDrive {
   Eigen::Vector2d wheel_angle_ = Eigen::Vector2d::Zero();
   std::mt19937 rng_;
 };
-
-/// Pose composition for planar poses (x, y, yaw): a ⊕ b.
-Eigen::Vector3d composePose(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
-/// Moves a pose along a constant-velocity arc: travel ds [m] while turning dtheta [rad].
-Eigen::Vector3d integrateArc(const Eigen::Vector3d& pose, double ds, double dtheta);
-/// Wraps an angle to (-pi, pi].
-double normalizeAngle(double a);
 
 }  // namespace core
 }  // namespace mbot

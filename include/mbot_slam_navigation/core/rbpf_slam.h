@@ -1,0 +1,107 @@
+// Rao-Blackwellized particle filter SLAM, GMapping's algorithm (Grisetti et al., IEEE T-RO 2007):
+// each particle carries a pose, its trajectory and its own map (SlamGrid, patches shared with its
+// relatives). Odometry moves every particle through the motion model; every linearUpdate metres,
+// angularUpdate radians or temporalUpdate seconds, a scan is processed:
+//   1. each particle's pose is scan-matched against its own map (the mode of the proposal);
+//   2. the improved proposal: the scan likelihood is evaluated on a small grid around the matched
+//      pose (llsamplerange/llsamplestep in x and y, lasamplerange/lasamplestep in yaw); the new pose
+//      is drawn from the gaussian they define and the particle's weight multiplies by their sum;
+//   3. weights are normalized (with ogain flattening them) and, when the effective sample size
+//      falls below resampleThreshold * particles, particles are resampled (low variance);
+//   4. the scan is registered into every particle's map.
+// Frames: odometry poses are base_footprint in odom; particle poses are base_footprint in map.
+#pragma once
+
+#include <memory>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/motion_model.h"
+#include "mbot_slam_navigation/core/scan_matcher.h"
+#include "mbot_slam_navigation/core/slam_grid.h"
+
+namespace mbot {
+namespace core {
+
+struct RbpfParams {
+  int particles = 30;               ///< `particles`
+  double linear_update = 1.0;       ///< [m] `linearUpdate`
+  double angular_update = 0.5;      ///< [rad] `angularUpdate`
+  double temporal_update = -1.0;    ///< [s] `temporalUpdate`; < 0 disables
+  double resample_threshold = 0.5;  ///< `resampleThreshold` (fraction of particles)
+  double ogain = 3.0;               ///< `ogain`: weights are exp(l / (ogain * particles))... see .cpp
+  double minimum_score = 0.0;       ///< `minimumScore`: a worse match keeps the odometry pose
+  double llsamplerange = 0.01, llsamplestep = 0.01;   ///< [m] proposal sampling in x, y
+  double lasamplerange = 0.005, lasamplestep = 0.005; ///< [rad] proposal sampling in yaw
+  double delta = 0.05;              ///< [m] map resolution (`delta`)
+  double xmin = -100, ymin = -100, xmax = 100, ymax = 100;  ///< [m] initial map extent (grows)
+  unsigned seed = 0;
+  MotionModelParams motion;
+  ScanMatcherParams matcher;
+  void validate() const;  ///< std::invalid_argument naming the gmapping parameter
+};
+
+/// One node of a particle's trajectory (shared by the descendants of the particle that made it).
+struct TrajectoryNode {
+  Eigen::Vector3d pose;       ///< base in map
+  Eigen::Vector3d odom;       ///< base in odom at the same time
+  double time_s;
+  std::shared_ptr<const TrajectoryNode> parent;
+};
+
+struct Particle {
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();
+  double log_weight = 0.0;     ///< since the last resampling
+  double weight_sum = 0.0;     ///< accumulated log-likelihood of the whole history
+  SlamGrid map;
+  std::shared_ptr<const TrajectoryNode> node;
+};
+
+/// Low-variance (systematic) resampling: n = weights.size() evenly spaced pointers starting at
+/// `offset` in [0, 1/n) over the cumulative normalized weights; returns the chosen indices, in
+/// order. O(n). Any particle with weight above 1/n is chosen at least once.
+std::vector<int> lowVarianceResample(const std::vector<double>& weights, double offset);
+
+class RbpfSlam {
+ public:
+  explicit RbpfSlam(const RbpfParams& params);
+
+  /// Feeds one scan with the odometry pose at its time. Returns true when the scan updated the
+  /// filter (motion since the last update exceeded the thresholds, or the first scan).
+  bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s);
+
+  int bestIndex() const;
+  const Particle& best() const { return particles_[bestIndex()]; }
+  const std::vector<Particle>& particles() const { return particles_; }
+  /// The best particle's pose composed with odometry since its last update: base in map now.
+  Eigen::Vector3d currentPose() const;
+  /// The best particle's trajectory, oldest first.
+  std::vector<TrajectoryNode> bestTrajectory() const;
+  /// Entropy of the particles' pose distribution (gaussian fit) [nats].
+  double poseEntropy() const;
+  double lastNeff() const { return last_neff_; }
+  int updates() const { return updates_; }
+  int resamples() const { return resamples_; }
+  const RbpfParams& params() const { return params_; }
+
+ private:
+  void drawFromProposal(Particle& p, const PreparedScan& scan);
+  void normalizeAndResample();
+
+  RbpfParams params_;
+  MotionModel motion_;
+  ScanMatcher matcher_;
+  std::mt19937 rng_;
+  std::vector<Particle> particles_;
+  bool initialized_ = false;
+  Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_update_odom_ = Eigen::Vector3d::Zero();
+  double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0;
+  double last_neff_ = 0.0;
+  int updates_ = 0, resamples_ = 0;
+};
+
+}  // namespace core
+}  // namespace mbot

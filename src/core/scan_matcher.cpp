@@ -1,0 +1,151 @@
+#include "mbot_slam_navigation/core/scan_matcher.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "mbot_slam_navigation/core/pose2d.h"
+
+namespace mbot {
+namespace core {
+
+void ScanMatcherParams::validate() const {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument(std::string(name) + " must be positive, got " + std::to_string(v));
+  };
+  positive(sigma, "sigma");
+  positive(lstep, "lstep");
+  positive(astep, "astep");
+  positive(lsigma, "lsigma");
+  positive(max_urange, "maxUrange");
+  positive(max_range, "maxRange");
+  if (kernel_size < 0) throw std::invalid_argument("kernelSize must be >= 0");
+  if (iterations < 0) throw std::invalid_argument("iterations must be >= 0");
+  if (lskip < 0) throw std::invalid_argument("lskip must be >= 0");
+}
+
+ScanMatcher::ScanMatcher(const ScanMatcherParams& params, double resolution_m) : params_(params), resolution_(resolution_m) {
+  params_.validate();
+}
+
+PreparedScan ScanMatcher::prepare(const LaserScan& scan) const {
+  PreparedScan out;
+  const double back = std::sqrt(2.0) * resolution_;
+  out.hit.reserve(scan.ranges_m.size());
+  out.free.reserve(scan.ranges_m.size());
+  for (std::size_t i = 0; i < scan.ranges_m.size(); i += params_.lskip + 1) {
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r < scan.range_min_m || r >= params_.max_range || r > params_.max_urange || r <= 0.0) continue;
+    const double a = params_.laser_pose.z() + scan.beamAngle(i);
+    const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+    const Eigen::Vector2d origin = params_.laser_pose.head<2>();
+    out.hit.push_back(origin + r * dir);
+    out.free.push_back(origin + (r - back) * dir);
+  }
+  return out;
+}
+
+void ScanMatcher::likelihoodAndScore(const SlamGrid& map, const Eigen::Vector3d& pose, const PreparedScan& scan,
+                                     double* score, double* log_likelihood, int* matched) const {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  const double inv_sigma = 1.0 / params_.sigma, inv_lsigma = 1.0 / params_.lsigma;
+  const double no_hit = params_.null_likelihood * inv_lsigma;
+  const int k = params_.kernel_size;
+  double sc = 0.0, ll = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < scan.hit.size(); ++i) {
+    const Eigen::Vector2d& h = scan.hit[i];
+    const Eigen::Vector2d& f = scan.free[i];
+    const Eigen::Vector2d phit(pose.x() + c * h.x() - s * h.y(), pose.y() + s * h.x() + c * h.y());
+    const Eigen::Vector2d pfree(pose.x() + c * f.x() - s * f.y(), pose.y() + s * f.x() + c * f.y());
+    const Cell ihit = map.worldToCell(phit);
+    const Cell ifree = map.worldToCell(pfree);
+    const int fdx = ifree.x - ihit.x, fdy = ifree.y - ihit.y;
+    double best = std::numeric_limits<double>::infinity();
+    for (int dx = -k; dx <= k; ++dx) {
+      for (int dy = -k; dy <= k; ++dy) {
+        const Cell cc{ihit.x + dx, ihit.y + dy};
+        const HitCell& cell = map.cell(cc);
+        if (cell.visits == 0 || cell.occupancy() <= params_.fullness_threshold) continue;
+        const HitCell& fcell = map.cell({cc.x + fdx, cc.y + fdy});
+        if (fcell.occupancy() >= params_.fullness_threshold) continue;
+        best = std::min(best, (phit - map.hitMean(cc)).squaredNorm());
+      }
+    }
+    if (std::isfinite(best)) {
+      sc += std::exp(-best * inv_sigma);
+      ll += -best * inv_lsigma;
+      ++n;
+    } else {
+      ll += no_hit;
+    }
+  }
+  *score = sc;
+  *log_likelihood = ll;
+  if (matched) *matched = n;
+}
+
+double ScanMatcher::score(const SlamGrid& map, const Eigen::Vector3d& pose, const PreparedScan& scan) const {
+  double s, l;
+  likelihoodAndScore(map, pose, scan, &s, &l);
+  return s;
+}
+
+Eigen::Vector3d ScanMatcher::optimize(const SlamGrid& map, const Eigen::Vector3d& init, const PreparedScan& scan,
+                                      double* best_score) const {
+  Eigen::Vector3d current = init;
+  double current_score = score(map, current, scan);
+  double ldelta = params_.lstep, adelta = params_.astep;
+  double best = -1.0;
+  int refinement = 0;
+  static const double kMoves[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, -1}};
+  do {
+    if (best >= current_score) {
+      ++refinement;
+      ldelta *= 0.5;
+      adelta *= 0.5;
+    }
+    best = current_score;
+    Eigen::Vector3d best_local = current;
+    for (const auto& m : kMoves) {
+      const Eigen::Vector3d candidate(current.x() + m[0] * ldelta, current.y() + m[1] * ldelta,
+                                      normalizeAngle(current.z() + m[2] * adelta));
+      const double sc = score(map, candidate, scan);
+      if (sc > current_score) {
+        current_score = sc;
+        best_local = candidate;
+      }
+    }
+    current = best_local;
+  } while (current_score > best || refinement < params_.iterations);
+  *best_score = best;
+  return current;
+}
+
+void ScanMatcher::registerScan(SlamGrid& map, const Eigen::Vector3d& pose, const LaserScan& scan) const {
+  const Eigen::Vector3d laser = composePose(pose, params_.laser_pose);
+  const Eigen::Vector2d from = laser.head<2>();
+  const double reach = std::min(params_.max_urange, params_.max_range);
+  const double clear_on_no_return = std::min(params_.max_urange, scan.range_max_m);
+  map.growToInclude(from - Eigen::Vector2d::Constant(reach + 1.0), from + Eigen::Vector2d::Constant(reach + 1.0));
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    double r = scan.ranges_m[i];
+    if (std::isnan(r) || r < scan.range_min_m || r <= 0.0) continue;
+    bool hit = true;
+    if (std::isinf(r)) {
+      r = clear_on_no_return;  // REP 117: nothing within range_max, as far as we trust the sensor
+      hit = false;
+    } else if (r >= params_.max_range) {
+      continue;  // gmapping: a reading at or beyond maxRange says nothing (no echo, glass)
+    } else if (r > params_.max_urange) {
+      r = params_.max_urange;
+      hit = false;
+    }
+    const double a = laser.z() + scan.beamAngle(i);
+    map.registerBeam(from, from + r * Eigen::Vector2d(std::cos(a), std::sin(a)), hit);
+  }
+}
+
+}  // namespace core
+}  // namespace mbot

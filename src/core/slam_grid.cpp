@@ -1,0 +1,152 @@
+#include "mbot_slam_navigation/core/slam_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "mbot_slam_navigation/core/bresenham.h"
+
+namespace mbot {
+namespace core {
+namespace {
+const HitCell kEmptyCell{};
+}
+
+SlamGrid::SlamGrid(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m, double resolution_m)
+    : resolution_(resolution_m) {
+  if (!(resolution_m > 0.0)) throw std::invalid_argument("SlamGrid: delta (resolution) must be positive");
+  if (!(max_m.x() > min_m.x() && max_m.y() > min_m.y())) {
+    throw std::invalid_argument("SlamGrid: xmax/ymax must exceed xmin/ymin");
+  }
+  const double patch_m = kPatchSize * resolution_;
+  origin_ = min_m;
+  patches_x_ = std::max(1, static_cast<int>(std::ceil((max_m.x() - min_m.x()) / patch_m)));
+  patches_y_ = std::max(1, static_cast<int>(std::ceil((max_m.y() - min_m.y()) / patch_m)));
+  patches_.assign(static_cast<std::size_t>(patches_x_) * patches_y_, nullptr);
+}
+
+Cell SlamGrid::worldToCell(const Eigen::Vector2d& p) const {
+  return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
+              static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
+}
+
+Eigen::Vector2d SlamGrid::cellCenter(const Cell& c) const {
+  return origin_ + Eigen::Vector2d(c.x + 0.5, c.y + 0.5) * resolution_;
+}
+
+const HitCell& SlamGrid::cell(const Cell& c) const {
+  if (c.x < 0 || c.y < 0) return kEmptyCell;
+  const int px = c.x >> kPatchBits, py = c.y >> kPatchBits;
+  if (px >= patches_x_ || py >= patches_y_) return kEmptyCell;
+  const Patch* p = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
+  if (!p) return kEmptyCell;
+  return p->cells[((c.y & (kPatchSize - 1)) << kPatchBits) | (c.x & (kPatchSize - 1))];
+}
+
+Eigen::Vector2d SlamGrid::hitMean(const Cell& c) const {
+  const HitCell& h = cell(c);
+  Eigen::Vector2d centre = cellCenter(c);
+  if (h.hits == 0) return centre;
+  return centre + Eigen::Vector2d(h.acc_x, h.acc_y) / static_cast<double>(h.hits);
+}
+
+HitCell& SlamGrid::writableCell(const Cell& c) {
+  std::shared_ptr<Patch>& p = patches_[static_cast<std::size_t>(c.y >> kPatchBits) * patches_x_ + (c.x >> kPatchBits)];
+  if (!p) {
+    p = std::make_shared<Patch>();
+  } else if (p.use_count() > 1) {
+    p = std::make_shared<Patch>(*p);  // copy on write: the other owners keep the old patch
+  }
+  return p->cells[((c.y & (kPatchSize - 1)) << kPatchBits) | (c.x & (kPatchSize - 1))];
+}
+
+void SlamGrid::growToInclude(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m) {
+  const double patch_m = kPatchSize * resolution_;
+  const int add_left = std::max(0, static_cast<int>(std::ceil((origin_.x() - min_m.x()) / patch_m)));
+  const int add_bottom = std::max(0, static_cast<int>(std::ceil((origin_.y() - min_m.y()) / patch_m)));
+  const int add_right =
+      std::max(0, static_cast<int>(std::ceil((max_m.x() - (origin_.x() + patches_x_ * patch_m)) / patch_m)));
+  const int add_top =
+      std::max(0, static_cast<int>(std::ceil((max_m.y() - (origin_.y() + patches_y_ * patch_m)) / patch_m)));
+  if (add_left + add_bottom + add_right + add_top == 0) return;
+  const int nx = patches_x_ + add_left + add_right, ny = patches_y_ + add_bottom + add_top;
+  std::vector<std::shared_ptr<Patch>> grown(static_cast<std::size_t>(nx) * ny);
+  for (int y = 0; y < patches_y_; ++y) {
+    for (int x = 0; x < patches_x_; ++x) {
+      grown[static_cast<std::size_t>(y + add_bottom) * nx + x + add_left] =
+          std::move(patches_[static_cast<std::size_t>(y) * patches_x_ + x]);
+    }
+  }
+  patches_ = std::move(grown);
+  patches_x_ = nx;
+  patches_y_ = ny;
+  origin_ -= Eigen::Vector2d(add_left, add_bottom) * patch_m;
+}
+
+void SlamGrid::registerBeam(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit) {
+  const Cell end = worldToCell(to);
+  const int w = width(), h = height();
+  walkLine(worldToCell(from), end, [&](const Cell& c) {
+    if (c.x < 0 || c.y < 0 || c.x >= w || c.y >= h) return true;
+    HitCell& cell = writableCell(c);
+    ++cell.visits;
+    if (hit && c == end) {
+      const Eigen::Vector2d offset = to - cellCenter(c);
+      cell.acc_x += static_cast<float>(offset.x());
+      cell.acc_y += static_cast<float>(offset.y());
+      ++cell.hits;
+    }
+    return true;
+  });
+}
+
+OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
+  int px0 = patches_x_, py0 = patches_y_, px1 = -1, py1 = -1;
+  for (int py = 0; py < patches_y_; ++py) {
+    for (int px = 0; px < patches_x_; ++px) {
+      if (!patches_[static_cast<std::size_t>(py) * patches_x_ + px]) continue;
+      px0 = std::min(px0, px);
+      py0 = std::min(py0, py);
+      px1 = std::max(px1, px);
+      py1 = std::max(py1, py);
+    }
+  }
+  OccupancyImage img;
+  img.resolution = resolution_;
+  if (px1 < 0) return img;
+  img.width = (px1 - px0 + 1) * kPatchSize;
+  img.height = (py1 - py0 + 1) * kPatchSize;
+  img.origin = origin_ + Eigen::Vector2d(px0, py0) * kPatchSize * resolution_;
+  img.data.assign(static_cast<std::size_t>(img.width) * img.height, -1);
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const double occ = cell({x + px0 * kPatchSize, y + py0 * kPatchSize}).occupancy();
+      if (occ >= 0.0) img.data[static_cast<std::size_t>(y) * img.width + x] = occ > occ_thresh ? 100 : 0;
+    }
+  }
+  return img;
+}
+
+int SlamGrid::knownCount() const {
+  int n = 0;
+  for (const auto& p : patches_) {
+    if (!p) continue;
+    for (const HitCell& c : p->cells) n += c.visits > 0;
+  }
+  return n;
+}
+
+int SlamGrid::ownedPatches() const {
+  int n = 0;
+  for (const auto& p : patches_) n += p && p.use_count() == 1;
+  return n;
+}
+
+int SlamGrid::allocatedPatches() const {
+  int n = 0;
+  for (const auto& p : patches_) n += p != nullptr;
+  return n;
+}
+
+}  // namespace core
+}  // namespace mbot

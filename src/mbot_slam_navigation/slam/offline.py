@@ -1,0 +1,134 @@
+"""slam_offline: the SLAM core on a CARMEN log (or a rosbag), as fast as the CPU allows.
+
+Writes OUT.traj (`t x y theta` per scan: the best particle's trajectory, with odometry between its
+updates), OUT.pgm/OUT.yaml (map_server format) and OUT.timing.json (CPU seconds, scans, updates).
+Usage: slam_offline LOG [-o OUT] [--relations FILE] [--param name=value ...] [--quiet]
+"""
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+from mbot_slam_navigation.maps.map_io import save_map
+from mbot_slam_navigation.slam.carmen import read_log
+from mbot_slam_navigation.slam.rbpf import GMAPPING_DEFAULTS, RbpfSlam
+from mbot_slam_navigation.slam.relations import evaluate, read_relations
+
+
+def _compose(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], math.atan2(math.sin(a[2] + b[2]), math.cos(a[2] + b[2])))
+
+
+def _relative(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, b[2] - a[2])
+
+
+def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
+    """The pose at every scan: the last filter update before it, moved on by odometry."""
+    out = np.zeros((len(scans), 3))
+    times = trajectory[:, 0]
+    for i, scan in enumerate(scans):
+        k = max(0, int(np.searchsorted(times, scan.time, side='right')) - 1)
+        node_pose, node_odom = trajectory[k, 1:4], trajectory[k, 4:7]
+        out[i] = _compose(node_pose, _relative(node_odom, scan.odom))
+    return out
+
+
+def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
+    """Scans from a bag with their odometry (nearest odom message at or before each scan)."""
+    import rosbag  # only needed for bags
+    from mbot_slam_navigation.slam.carmen import Scan
+    scans, odom = [], None
+    with rosbag.Bag(path) as bag:
+        for topic, msg, _ in bag.read_messages(topics=[scan_topic, odom_topic]):
+            if topic == odom_topic:
+                q = msg.pose.pose.orientation
+                odom = (msg.pose.pose.position.x, msg.pose.pose.position.y,
+                        math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+            elif odom is not None:
+                scans.append(Scan(time=msg.header.stamp.to_sec(), odom=odom, laser_pose=(0.0, 0.0, 0.0),
+                                  angle_min=msg.angle_min, angle_increment=msg.angle_increment,
+                                  ranges=np.asarray(msg.ranges, np.float32)))
+    return scans
+
+
+class Progress:
+    """A one-line progress bar on stderr: scans done, rate, time left."""
+
+    def __init__(self, total, enabled=True):
+        self.total, self.enabled, self.start, self.last = total, enabled and sys.stderr.isatty() or enabled, time.time(), 0.0
+
+    def update(self, done, updates):
+        now = time.time()
+        if not self.enabled or (now - self.last < 0.5 and done < self.total):
+            return
+        self.last = now
+        rate = done / max(now - self.start, 1e-9)
+        left = (self.total - done) / rate if rate > 0 else float('inf')
+        bar = '#' * int(30 * done / self.total)
+        sys.stderr.write('\r[%-30s] %d/%d scans, %d updates, %.0f scans/s, %.0f s left ' %
+                         (bar, done, self.total, updates, rate, left))
+        if done >= self.total:
+            sys.stderr.write('\n')
+        sys.stderr.flush()
+
+
+def run(scans, params, progress=True):
+    """Runs the filter over the scans; returns (slam, cpu_seconds)."""
+    slam = RbpfSlam(laser_pose=scans[0].laser_pose, **params)
+    bar = Progress(len(scans), progress)
+    cpu = 0.0
+    for i, s in enumerate(scans):
+        c0 = time.process_time()
+        slam.process_scan(s.odom, s.angle_min, s.angle_increment, 0.0, params.get('maxRange', 80.0), s.ranges, s.time)
+        cpu += time.process_time() - c0
+        bar.update(i + 1, slam.updates)
+    return slam, cpu
+
+
+def parse_param(text):
+    name, _, value = text.partition('=')
+    if name not in GMAPPING_DEFAULTS or not value:
+        raise argparse.ArgumentTypeError('--param takes name=value with a slam_gmapping name, got "%s"' % text)
+    return name, float(value)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog='slam_offline', description=__doc__.split('\n')[0])
+    ap.add_argument('log', help='CARMEN log (.clf, .log, optionally .bz2) or rosbag (.bag)')
+    ap.add_argument('-o', '--out', help='output base name (default: the log name without extension)')
+    ap.add_argument('--relations', help='relations file: print the Kümmerle et al. error')
+    ap.add_argument('--param', action='append', type=parse_param, default=[], help='slam_gmapping name=value')
+    ap.add_argument('--quiet', action='store_true', help='no progress bar')
+    args = ap.parse_args(argv)
+    if not os.path.isfile(args.log):
+        ap.error('log file %s does not exist' % args.log)
+    scans = read_rosbag(args.log) if args.log.endswith('.bag') else read_log(args.log)
+    params = dict(args.param)
+    slam, cpu = run(scans, params, progress=not args.quiet)
+    out = args.out or os.path.basename(args.log).split('.')[0]
+    poses = per_scan_poses(slam.best_trajectory(), scans)
+    times = np.array([s.time for s in scans])
+    np.savetxt(out + '.traj', np.column_stack([times, poses]), fmt='%.6f', header='t x y theta')
+    data, origin, res = slam.best_map()
+    save_map(out, data, res, (origin[0], origin[1], 0.0))
+    duration = scans[-1].time - scans[0].time
+    summary = dict(log=args.log, scans=len(scans), updates=slam.updates, resamples=slam.resamples,
+                   cpu_seconds=cpu, log_duration_s=duration, params=params)
+    if args.relations:
+        e = evaluate(times, poses, read_relations(args.relations))
+        summary['relations'] = e.__dict__
+        print('error over %d relations: translation %.4f +- %.4f m, rotation %.3f +- %.3f deg'
+              % (e.count, e.trans_mean, e.trans_std, e.rot_mean, e.rot_std))
+    with open(out + '.timing.json', 'w') as f:
+        json.dump(summary, f, indent=1)
+    print('%d scans (%d updates) in %.1f CPU s for %.0f s of log (%.0fx); wrote %s.traj, %s.pgm, %s.yaml'
+          % (len(scans), slam.updates, cpu, duration, duration / max(cpu, 1e-9), out, out, out))
+    return 0

@@ -1,0 +1,273 @@
+// slam_gmapping: the gmapping node's interface on this package's C++ RBPF (core/rbpf_slam.h).
+//
+// Subscribes `scan` (with tf from its frame to ~base_frame and from ~base_frame to ~odom_frame);
+// publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy`; serves
+// `dynamic_map`; broadcasts ~map_frame -> ~odom_frame every ~transform_publish_period. Parameters
+// have gmapping's names and defaults; an unknown private parameter gets a warning naming the
+// nearest known one (the tutorial's `base_link` means `base_frame`).
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/GetMap.h>
+#include <nav_msgs/MapMetaData.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_msgs/Float64.h>
+#include <tf2/utils.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "mbot_slam_navigation/core/pose2d.h"
+#include "mbot_slam_navigation/core/rbpf_slam.h"
+#include "ros_conversions.h"
+
+namespace {
+
+using mbot::core::composePose;
+using mbot::core::inversePose;
+
+Eigen::Vector3d toPose(const geometry_msgs::TransformStamped& t) {
+  return {t.transform.translation.x, t.transform.translation.y, tf2::getYaw(t.transform.rotation)};
+}
+
+class SlamGmappingNode {
+ public:
+  SlamGmappingNode() : pnh_("~"), tf_listener_(tf_buffer_) {
+    readParameters();
+    map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+    meta_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
+    entropy_pub_ = pnh_.advertise<std_msgs::Float64>("entropy", 1, true);
+    map_srv_ = nh_.advertiseService("dynamic_map", &SlamGmappingNode::onDynamicMap, this);
+    scan_sub_ = nh_.subscribe("scan", 5, &SlamGmappingNode::onScan, this);
+    if (transform_publish_period_ > 0.0) {
+      tf_thread_ = std::thread([this] { publishTransformLoop(); });
+    }
+  }
+
+  ~SlamGmappingNode() {
+    if (tf_thread_.joinable()) tf_thread_.join();
+  }
+
+ private:
+  template <typename T>
+  void param(const std::string& name, T& value) {
+    known_.push_back(name);
+    pnh_.param(name, value, value);
+  }
+
+  void readParameters() {
+    param("base_frame", base_frame_);
+    param("odom_frame", odom_frame_);
+    param("map_frame", map_frame_);
+    param("map_update_interval", map_update_interval_);
+    param("transform_publish_period", transform_publish_period_);
+    param("occ_thresh", occ_thresh_);
+    param("throttle_scans", throttle_scans_);
+    param("tf_delay", tf_delay_);
+    auto& p = params_;
+    auto& m = p.matcher;
+    double max_urange = -1.0, max_range = -1.0;  // default: the scan's range_max, as gmapping
+    param("maxUrange", max_urange);
+    param("maxRange", max_range);
+    m.max_urange = max_urange;
+    m.max_range = max_range;
+    param("sigma", m.sigma);
+    param("kernelSize", m.kernel_size);
+    param("lstep", m.lstep);
+    param("astep", m.astep);
+    param("iterations", m.iterations);
+    param("lsigma", m.lsigma);
+    param("ogain", p.ogain);
+    param("lskip", m.lskip);
+    param("minimumScore", p.minimum_score);
+    param("srr", p.motion.srr);
+    param("srt", p.motion.srt);
+    param("str", p.motion.str);
+    param("stt", p.motion.stt);
+    param("linearUpdate", p.linear_update);
+    param("angularUpdate", p.angular_update);
+    param("temporalUpdate", p.temporal_update);
+    param("resampleThreshold", p.resample_threshold);
+    param("particles", p.particles);
+    param("xmin", p.xmin);
+    param("ymin", p.ymin);
+    param("xmax", p.xmax);
+    param("ymax", p.ymax);
+    param("delta", p.delta);
+    param("llsamplerange", p.llsamplerange);
+    param("llsamplestep", p.llsamplestep);
+    param("lasamplerange", p.lasamplerange);
+    param("lasamplestep", p.lasamplestep);
+    int seed = 0;
+    param("seed", seed);
+    p.seed = static_cast<unsigned>(seed);
+    for (std::string* frame : {&base_frame_, &odom_frame_, &map_frame_}) {
+      if (!frame->empty() && (*frame)[0] == '/') {
+        ROS_WARN("slam_gmapping: frame '%s' has a leading '/', which tf2 rejects; using '%s'", frame->c_str(),
+                 frame->substr(1).c_str());
+        *frame = frame->substr(1);
+      }
+    }
+    std::vector<std::string> names;
+    pnh_.getParamNames(names);
+    const std::string prefix = pnh_.getNamespace() + "/";
+    for (const std::string& full : names) {
+      if (full.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string key = full.substr(prefix.size());
+      if (key.find('/') != std::string::npos || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
+      ROS_WARN("slam_gmapping: unknown parameter ~%s is ignored; did you mean ~%s?", key.c_str(),
+               mbot::ros_glue::nearestName(key, known_).c_str());
+    }
+  }
+
+  void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
+    if (++scan_count_ % std::max(1, throttle_scans_) != 0) return;
+    const std::string problem = mbot::ros_glue::describeScanProblem(*msg);
+    if (!problem.empty()) {
+      ROS_WARN_THROTTLE(5.0, "slam_gmapping: skipping a scan on %s (frame '%s'): %s", scan_sub_.getTopic().c_str(),
+                        msg->header.frame_id.c_str(), problem.c_str());
+      return;
+    }
+    if (!last_stamp_.isZero() && msg->header.stamp + ros::Duration(1.0) < last_stamp_) {
+      ROS_WARN("slam_gmapping: time went backwards (scan at %.3f after %.3f; a bag restarted?): resetting the map",
+               msg->header.stamp.toSec(), last_stamp_.toSec());
+      std::lock_guard<std::mutex> lock(mutex_);
+      slam_.reset();
+      tf_buffer_.clear();
+      map_to_odom_.setZero();
+    }
+    last_stamp_ = msg->header.stamp;
+
+    geometry_msgs::TransformStamped base_laser, odom_base;
+    try {
+      base_laser = tf_buffer_.lookupTransform(base_frame_, msg->header.frame_id, msg->header.stamp, ros::Duration(0.2));
+      odom_base = tf_buffer_.lookupTransform(odom_frame_, base_frame_, msg->header.stamp, ros::Duration(0.2));
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(5.0, "slam_gmapping: skipping a scan on %s: no transform %s -> %s -> %s at %.3f: %s",
+                        scan_sub_.getTopic().c_str(), msg->header.frame_id.c_str(), base_frame_.c_str(),
+                        odom_frame_.c_str(), msg->header.stamp.toSec(), e.what());
+      return;
+    }
+    const Eigen::Vector3d odom = toPose(odom_base);
+    if (!slam_) {
+      auto params = params_;
+      params.matcher.laser_pose = toPose(base_laser);
+      if (params.matcher.max_range <= 0.0) params.matcher.max_range = msg->range_max + 0.01;
+      if (params.matcher.max_urange <= 0.0) params.matcher.max_urange = msg->range_max;
+      try {
+        std::lock_guard<std::mutex> lock(mutex_);
+        slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
+      } catch (const std::invalid_argument& e) {
+        ROS_FATAL("slam_gmapping: bad parameter: %s", e.what());
+        ros::shutdown();
+        return;
+      }
+      ROS_INFO("slam_gmapping: %d particles, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
+               params.particles, params.matcher.laser_pose.x(), params.matcher.laser_pose.y(),
+               params.matcher.laser_pose.z(), base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
+    }
+    bool updated;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
+      if (updated) {
+        const Eigen::Vector3d pose = slam_->best().pose;
+        map_to_odom_ = composePose(pose, inversePose(odom));
+      }
+    }
+    if (!updated) return;
+    std_msgs::Float64 entropy;
+    entropy.data = slam_->poseEntropy();
+    entropy_pub_.publish(entropy);
+    if (last_map_update_.isZero() || (msg->header.stamp - last_map_update_).toSec() >= map_update_interval_) {
+      publishMap(msg->header.stamp);
+      last_map_update_ = msg->header.stamp;
+    }
+  }
+
+  void publishMap(const ros::Time& stamp) {
+    nav_msgs::OccupancyGrid map;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!slam_) return;
+      const auto img = slam_->best().map.toOccupancy(occ_thresh_);
+      map.info.width = img.width;
+      map.info.height = img.height;
+      map.info.resolution = static_cast<float>(img.resolution);
+      map.info.origin.position.x = img.origin.x();
+      map.info.origin.position.y = img.origin.y();
+      map.info.origin.orientation.w = 1.0;
+      map.data.assign(img.data.begin(), img.data.end());
+    }
+    map.header.frame_id = map_frame_;
+    map.header.stamp = stamp;
+    map.info.map_load_time = stamp;
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    last_map_ = map;
+    map_pub_.publish(map);
+    meta_pub_.publish(map.info);
+  }
+
+  bool onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    if (last_map_.data.empty()) return false;  // gmapping answers false until it has a map
+    res.map = last_map_;
+    return true;
+  }
+
+  void publishTransformLoop() {
+    ros::Rate rate(1.0 / transform_publish_period_);
+    while (ros::ok()) {
+      Eigen::Vector3d m;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        m = map_to_odom_;
+      }
+      geometry_msgs::TransformStamped t;
+      // Stamped ahead, as gmapping does, so that lookups at "now" find it.
+      t.header.stamp = ros::Time::now() + ros::Duration(tf_delay_ > 0.0 ? tf_delay_ : transform_publish_period_);
+      t.header.frame_id = map_frame_;
+      t.child_frame_id = odom_frame_;
+      t.transform.translation.x = m.x();
+      t.transform.translation.y = m.y();
+      t.transform.rotation.z = std::sin(m.z() / 2.0);
+      t.transform.rotation.w = std::cos(m.z() / 2.0);
+      if (!t.header.stamp.isZero()) broadcaster_.sendTransform(t);
+      rate.sleep();
+    }
+  }
+
+  ros::NodeHandle nh_, pnh_;
+  std::vector<std::string> known_;
+  std::string base_frame_ = "base_link", odom_frame_ = "odom", map_frame_ = "map";
+  double map_update_interval_ = 5.0, transform_publish_period_ = 0.05, occ_thresh_ = 0.25, tf_delay_ = -1.0;
+  int throttle_scans_ = 1;
+  mbot::core::RbpfParams params_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::TransformBroadcaster broadcaster_;
+  ros::Publisher map_pub_, meta_pub_, entropy_pub_;
+  ros::Subscriber scan_sub_;
+  ros::ServiceServer map_srv_;
+  std::mutex mutex_, map_mutex_;
+  std::unique_ptr<mbot::core::RbpfSlam> slam_;
+  Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
+  nav_msgs::OccupancyGrid last_map_;
+  ros::Time last_stamp_, last_map_update_;
+  long scan_count_ = 0;
+  std::thread tf_thread_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "slam_gmapping");
+  SlamGmappingNode node;
+  ros::spin();
+  return 0;
+}

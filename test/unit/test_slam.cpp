@@ -1,0 +1,185 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "mbot_slam_navigation/core/motion_model.h"
+#include "mbot_slam_navigation/core/pose2d.h"
+#include "mbot_slam_navigation/core/rbpf_slam.h"
+#include "mbot_slam_navigation/core/scan_matcher.h"
+#include "mbot_slam_navigation/core/slam_grid.h"
+#include "mbot_slam_navigation/core/world2d.h"
+
+using namespace mbot::core;
+
+namespace {
+// An 8 m x 6 m room with a pillar and a cupboard, so that a scan fixes all three pose dimensions.
+World2D syntheticRoom() {
+  World2D w;
+  w.addBox({0, 3.05}, 0, 8.2, 0.1);
+  w.addBox({0, -3.05}, 0, 8.2, 0.1);
+  w.addBox({4.05, 0}, 0, 0.1, 6.2);
+  w.addBox({-4.05, 0}, 0, 0.1, 6.2);
+  w.addBox({1.5, 1.0}, 0.4, 0.6, 0.6);
+  w.addBox({-2.5, -2.2}, 0, 1.2, 0.8);
+  w.addCylinder({-1.0, 1.5}, 0.3);
+  return w;
+}
+
+LaserScan scanAt(const World2D& w, const Eigen::Vector3d& pose, std::mt19937& rng, double noise = 0.0) {
+  LaserScan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = M_PI / 180;
+  s.range_min_m = 0.1;
+  s.range_max_m = 10.0;
+  s.ranges_m.resize(360);
+  w.castScan(pose, s.angle_min_rad, s.angle_increment_rad, 360, 0.1, 10.0, noise, 0.0, rng, s.ranges_m.data());
+  return s;
+}
+
+ScanMatcherParams matcherParams() {
+  ScanMatcherParams p;
+  p.max_urange = 9.0;
+  p.max_range = 10.0;
+  return p;
+}
+}  // namespace
+
+TEST(ScanMatcher, RecoversAKnownOffsetInASyntheticRoom) {
+  const World2D room = syntheticRoom();
+  std::mt19937 rng(11);
+  const ScanMatcher matcher(matcherParams(), 0.05);
+  SlamGrid map({-5, -4}, {5, 4}, 0.05);
+  const Eigen::Vector3d truth(0.3, -0.4, 0.2);
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, -1, 1.0), Eigen::Vector3d(-1, 0.5, -2.0)}) {
+    matcher.registerScan(map, p, scanAt(room, p, rng));
+  }
+  const PreparedScan scan = matcher.prepare(scanAt(room, truth, rng, 0.01));
+  for (const Eigen::Vector3d& offset : {Eigen::Vector3d(0.15, -0.1, 0.05), Eigen::Vector3d(-0.1, 0.12, -0.06)}) {
+    double score = 0;
+    const Eigen::Vector3d start(truth.x() + offset.x(), truth.y() + offset.y(), truth.z() + offset.z());
+    const Eigen::Vector3d found = matcher.optimize(map, start, scan, &score);
+    EXPECT_NEAR(found.x(), truth.x(), 0.02);
+    EXPECT_NEAR(found.y(), truth.y(), 0.02);
+    EXPECT_NEAR(found.z(), truth.z(), 0.01);
+    EXPECT_GT(score, matcher.score(map, start, scan));
+  }
+}
+
+TEST(ScanMatcher, LikelihoodPrefersTheTruePose) {
+  const World2D room = syntheticRoom();
+  std::mt19937 rng(2);
+  const ScanMatcher matcher(matcherParams(), 0.05);
+  SlamGrid map({-5, -4}, {5, 4}, 0.05);
+  matcher.registerScan(map, {0, 0, 0}, scanAt(room, {0, 0, 0}, rng));
+  const PreparedScan scan = matcher.prepare(scanAt(room, {0.5, 0.2, 0.1}, rng));
+  double s_true, l_true, s_off, l_off;
+  matcher.likelihoodAndScore(map, {0.5, 0.2, 0.1}, scan, &s_true, &l_true);
+  matcher.likelihoodAndScore(map, {0.6, 0.2, 0.1}, scan, &s_off, &l_off);
+  EXPECT_GT(l_true, l_off);
+  EXPECT_GT(s_true, s_off);
+}
+
+TEST(SlamGrid, GrowthKeepsOldCellsAndCopiesOnWrite) {
+  SlamGrid a({0, 0}, {1, 1}, 0.05);
+  a.registerBeam({0.1, 0.1}, {0.5, 0.5}, true);
+  const Cell hit = a.worldToCell({0.5, 0.5});
+  const Eigen::Vector2d hit_world = a.cellCenter(hit);
+  ASSERT_EQ(a.cell(hit).hits, 1u);
+  a.growToInclude({-3, -2}, {4, 1});
+  const Cell moved = a.worldToCell(hit_world);
+  EXPECT_EQ(a.cell(moved).hits, 1u);
+  EXPECT_NEAR((a.hitMean(moved) - Eigen::Vector2d(0.5, 0.5)).norm(), 0.0, 1e-6);  // sub-cell hit point kept
+  EXPECT_LE(a.origin().x(), -3.0);
+
+  SlamGrid b = a;  // a particle copied at resampling: shares every patch
+  EXPECT_EQ(b.ownedPatches(), 0);
+  b.registerBeam({0.1, 0.1}, {0.5, 0.5}, true);
+  EXPECT_EQ(b.cell(moved).hits, 2u);
+  EXPECT_EQ(a.cell(moved).hits, 1u);  // the other copy did not change
+  EXPECT_GT(b.ownedPatches(), 0);
+  EXPECT_LT(b.ownedPatches(), b.allocatedPatches() + 1);
+}
+
+TEST(MotionModel, SampleStatisticsMatchTheParameters) {
+  MotionModelParams p;
+  p.srr = 0.1;
+  p.srt = 0.2;
+  p.str = 0.1;
+  p.stt = 0.2;
+  const MotionModel model(p);
+  std::mt19937 rng(5);
+  const Eigen::Vector3d odom_old(1.0, 2.0, 0.5), odom_new = composePose(odom_old, {0.5, 0.0, 0.2});
+  const Eigen::Vector3d expected_sd = model.stddev({0.5, 0.0, 0.2});
+  EXPECT_NEAR(expected_sd.x(), 0.1 * 0.5 + 0.1 * 0.2, 1e-12);
+  EXPECT_NEAR(expected_sd.z(), 0.2 * 0.2 + 0.2 * 0.5, 1e-12);
+  const int n = 20000;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum2 = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d d = relativePose(Eigen::Vector3d::Zero(), model.sample({0, 0, 0}, odom_new, odom_old, rng));
+    // compare in the increment's own coordinates
+    sum += d;
+    sum2 += d.cwiseProduct(d);
+  }
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Vector3d sd = (sum2 / n - mean.cwiseProduct(mean)).cwiseSqrt();
+  EXPECT_NEAR(mean.x(), 0.5, 0.005);
+  EXPECT_NEAR(mean.z(), 0.2, 0.005);
+  EXPECT_NEAR(sd.x(), expected_sd.x(), 0.004);
+  EXPECT_NEAR(sd.y(), expected_sd.y(), 0.004);
+  EXPECT_NEAR(sd.z(), expected_sd.z(), 0.004);
+}
+
+TEST(Resampling, KeepsTheBestParticleAndIsProportional) {
+  const std::vector<double> w{0.01, 0.70, 0.04, 0.20, 0.05};
+  for (double offset : {0.0, 0.05, 0.1, 0.1999}) {
+    const auto idx = lowVarianceResample(w, offset);
+    ASSERT_EQ(idx.size(), w.size());
+    EXPECT_GE(std::count(idx.begin(), idx.end(), 1), 3);  // 0.7 * 5 = 3.5 copies: 3 or 4
+    EXPECT_LE(std::count(idx.begin(), idx.end(), 1), 4);
+    EXPECT_GE(std::count(idx.begin(), idx.end(), 3), 1);  // weight above 1/n: kept
+    EXPECT_TRUE(std::is_sorted(idx.begin(), idx.end()));
+  }
+}
+
+TEST(RbpfSlam, BeatsDriftingOdometryAroundTheRoom) {
+  const World2D room = syntheticRoom();
+  RbpfParams p;
+  p.particles = 10;
+  p.linear_update = 0.2;
+  p.angular_update = 0.2;
+  p.matcher = matcherParams();
+  p.seed = 3;
+  RbpfSlam slam(p);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> slip(0.0, 0.03);
+  Eigen::Vector3d truth(-2.5, 0.0, 0.0), odom = truth;
+  // A lap around the room: 0.05 m steps, turning at the corners; odometry drifts (biased turn).
+  double odom_err = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    const double ds = 0.05, dth = (i % 100 > 80) ? 0.075 : 0.0;
+    truth = integrateArc(truth, ds, dth);
+    odom = integrateArc(odom, ds * (1 + slip(rng)), dth * 1.05 + 0.002);
+    slam.processScan(odom, scanAt(room, truth, rng, 0.01), i * 0.1);
+  }
+  odom_err = (odom.head<2>() - truth.head<2>()).norm();
+  const Eigen::Vector3d est = slam.currentPose();
+  EXPECT_GT(odom_err, 0.3);
+  EXPECT_LT((est.head<2>() - truth.head<2>()).norm(), 0.1) << "odometry error was " << odom_err;
+  EXPECT_LT(std::abs(normalizeAngle(est.z() - truth.z())), 0.05);
+  EXPECT_GT(slam.updates(), 50);
+}
+
+TEST(RbpfSlam, RejectsBadParametersByName) {
+  RbpfParams p;
+  p.particles = 0;
+  EXPECT_THROW(RbpfSlam{p}, std::invalid_argument);
+  p = RbpfParams();
+  p.motion.srr = -1;
+  try {
+    RbpfSlam s(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("srr"), std::string::npos);
+  }
+}
