@@ -1,5 +1,6 @@
 #include "mbot_slam_navigation/core/scan_matcher.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -52,6 +53,8 @@ void ScanMatcher::likelihoodAndScore(const SlamGrid& map, const Eigen::Vector3d&
   const double inv_sigma = 1.0 / params_.sigma, inv_lsigma = 1.0 / params_.lsigma;
   const double no_hit = params_.null_likelihood * inv_lsigma;
   const int k = params_.kernel_size;
+  const Eigen::Vector2d origin = map.origin();
+  const double res = map.resolution();
   double sc = 0.0, ll = 0.0;
   int n = 0;
   for (std::size_t i = 0; i < scan.hit.size(); ++i) {
@@ -67,10 +70,14 @@ void ScanMatcher::likelihoodAndScore(const SlamGrid& map, const Eigen::Vector3d&
       for (int dy = -k; dy <= k; ++dy) {
         const Cell cc{ihit.x + dx, ihit.y + dy};
         const HitCell& cell = map.cell(cc);
-        if (cell.visits == 0 || cell.occupancy() <= params_.fullness_threshold) continue;
+        // hits > threshold * visits, i.e. occupancy above the threshold, without a division
+        if (cell.visits == 0 || cell.hits <= params_.fullness_threshold * cell.visits) continue;
         const HitCell& fcell = map.cell({cc.x + fdx, cc.y + fdy});
-        if (fcell.occupancy() >= params_.fullness_threshold) continue;
-        best = std::min(best, (phit - map.hitMean(cc)).squaredNorm());
+        if (fcell.visits > 0 && fcell.hits >= params_.fullness_threshold * fcell.visits) continue;
+        const double inv = 1.0 / cell.hits;
+        const double mx = origin.x() + (cc.x + 0.5) * res + cell.acc_x * inv;
+        const double my = origin.y() + (cc.y + 0.5) * res + cell.acc_y * inv;
+        best = std::min(best, (phit.x() - mx) * (phit.x() - mx) + (phit.y() - my) * (phit.y() - my));
       }
     }
     if (std::isfinite(best)) {
@@ -126,9 +133,12 @@ Eigen::Vector3d ScanMatcher::optimize(const SlamGrid& map, const Eigen::Vector3d
 void ScanMatcher::registerScan(SlamGrid& map, const Eigen::Vector3d& pose, const LaserScan& scan) const {
   const Eigen::Vector3d laser = composePose(pose, params_.laser_pose);
   const Eigen::Vector2d from = laser.head<2>();
-  const double reach = std::min(params_.max_urange, params_.max_range);
   const double clear_on_no_return = std::min(params_.max_urange, scan.range_max_m);
-  map.growToInclude(from - Eigen::Vector2d::Constant(reach + 1.0), from + Eigen::Vector2d::Constant(reach + 1.0));
+  // End points first, so that the map grows to what this scan reaches and no further: every
+  // particle's patch table is copied at resampling, so its size is on the hot path.
+  std::vector<std::pair<Eigen::Vector2d, bool>> beams;
+  beams.reserve(scan.ranges_m.size());
+  Eigen::Vector2d lo = from, hi = from;
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     double r = scan.ranges_m[i];
     if (std::isnan(r) || r < scan.range_min_m || r <= 0.0) continue;
@@ -143,8 +153,13 @@ void ScanMatcher::registerScan(SlamGrid& map, const Eigen::Vector3d& pose, const
       hit = false;
     }
     const double a = laser.z() + scan.beamAngle(i);
-    map.registerBeam(from, from + r * Eigen::Vector2d(std::cos(a), std::sin(a)), hit);
+    const Eigen::Vector2d end = from + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    lo = lo.cwiseMin(end);
+    hi = hi.cwiseMax(end);
+    beams.emplace_back(end, hit);
   }
+  map.growToInclude(lo - Eigen::Vector2d::Constant(1.0), hi + Eigen::Vector2d::Constant(1.0));
+  for (const auto& b : beams) map.registerBeam(from, b.first, b.second);
 }
 
 }  // namespace core

@@ -8,9 +8,7 @@
 
 namespace mbot {
 namespace core {
-namespace {
-const HitCell kEmptyCell{};
-}
+const HitCell SlamGrid::empty_cell_{};
 
 SlamGrid::SlamGrid(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m, double resolution_m)
     : resolution_(resolution_m) {
@@ -25,22 +23,8 @@ SlamGrid::SlamGrid(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m, d
   patches_.assign(static_cast<std::size_t>(patches_x_) * patches_y_, nullptr);
 }
 
-Cell SlamGrid::worldToCell(const Eigen::Vector2d& p) const {
-  return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
-              static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
-}
-
 Eigen::Vector2d SlamGrid::cellCenter(const Cell& c) const {
   return origin_ + Eigen::Vector2d(c.x + 0.5, c.y + 0.5) * resolution_;
-}
-
-const HitCell& SlamGrid::cell(const Cell& c) const {
-  if (c.x < 0 || c.y < 0) return kEmptyCell;
-  const int px = c.x >> kPatchBits, py = c.y >> kPatchBits;
-  if (px >= patches_x_ || py >= patches_y_) return kEmptyCell;
-  const Patch* p = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
-  if (!p) return kEmptyCell;
-  return p->cells[((c.y & (kPatchSize - 1)) << kPatchBits) | (c.x & (kPatchSize - 1))];
 }
 
 Eigen::Vector2d SlamGrid::hitMean(const Cell& c) const {

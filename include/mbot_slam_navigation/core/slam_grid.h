@@ -6,6 +6,7 @@
 // whole patches when a scan reaches beyond it, keeping every cell's world position.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -47,10 +48,21 @@ class SlamGrid {
   int width() const { return patches_x_ * kPatchSize; }
   int height() const { return patches_y_ * kPatchSize; }
 
-  Cell worldToCell(const Eigen::Vector2d& p) const;
+  // Inline: these two are the scan matcher's inner loop.
+  Cell worldToCell(const Eigen::Vector2d& p) const {
+    return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
+                static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
+  }
   Eigen::Vector2d cellCenter(const Cell& c) const;
   /// The cell (a shared empty cell outside the grid or in unwritten patches).
-  const HitCell& cell(const Cell& c) const;
+  const HitCell& cell(const Cell& c) const {
+    if (c.x < 0 || c.y < 0) return empty_cell_;
+    const int px = c.x >> kPatchBits, py = c.y >> kPatchBits;
+    if (px >= patches_x_ || py >= patches_y_) return empty_cell_;
+    const Patch* p = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
+    if (!p) return empty_cell_;
+    return p->cells[((c.y & (kPatchSize - 1)) << kPatchBits) | (c.x & (kPatchSize - 1))];
+  }
   /// Mean hit point of a cell [m, world]; its centre when it has no hits.
   Eigen::Vector2d hitMean(const Cell& c) const;
 
@@ -73,6 +85,7 @@ class SlamGrid {
     HitCell cells[kPatchSize * kPatchSize];
   };
   HitCell& writableCell(const Cell& c);
+  static const HitCell empty_cell_;
 
   double resolution_;
   Eigen::Vector2d origin_;
