@@ -21,9 +21,8 @@ from mbot_slam_navigation.slam.relations import evaluate, read_relations
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.environ.get('RADISH_DIR', os.path.join(HERE, '..', '..', 'shared', 'data', 'radish'))
 OUT = os.path.join(HERE, 'out')
-# Changed from slam_gmapping's defaults (particles stays 30): more frequent filter updates, which
-# these logs' turns in place need.
-PARAMS = {'linearUpdate': 0.5, 'angularUpdate': 0.25}
+# slam_gmapping's defaults throughout (30 particles, maxUrange 80 m, linearUpdate 1 m, ...).
+PARAMS = {}
 LOGS = [('aces', 'aces.clf.bz2', 'aces.relations', 0.06), ('fr079', 'fr079.clf.bz2', 'fr079.relations', 0.06),
         ('mit-csail', 'mit-csail.clf.bz2', None, None)]
 
@@ -38,7 +37,7 @@ def main():
         print('no Radish data at %s (set RADISH_DIR)' % DATA)
         return 1
     os.makedirs(OUT, exist_ok=True)
-    print('parameters (besides ROS defaults, 30 particles): %s' % PARAMS, flush=True)
+    print('parameters: slam_gmapping defaults%s' % (', except %s' % PARAMS if PARAMS else ''), flush=True)
     for name, log, rel, target in LOGS:
         scans = read_log(os.path.join(DATA, log))
         slam, cpu = run(scans, dict(PARAMS), progress=sys.stderr.isatty())

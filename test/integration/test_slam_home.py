@@ -13,8 +13,9 @@ import rospkg
 import rospy
 import rostest
 import tf2_ros
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import OccupancyGrid, Odometry
+from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, occupied_points
 from mbot_slam_navigation.sim.sdf_world import load_world
@@ -81,25 +82,71 @@ class SlamHomeTest(unittest.TestCase):
         self.assertLess(np.percentile(d, 95), 0.1, 'walls off the true walls: 95th percentile %.3f m' % np.percentile(d, 95))
         self.assertLess(np.median(d), 0.05)
 
-    def test_tutorial_typo_gets_a_warning(self):
-        # The tutorial sets ~base_link (a typo for ~base_frame). Start a second, idle instance as the
-        # tutorial would (no scans, no tf) and read what it prints in the terminal.
+    def test_tutorial_typo_and_bad_scans_get_warnings(self):
+        # A second instance, started as the tutorial does (~base_link, a typo for ~base_frame), in
+        # frames of its own, fed by this test: the warnings a user reads in the terminal.
+        ns = '/tc'
         proc = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=typo_check',
-                                 '_base_link:=base_footprint', '_transform_publish_period:=0', 'scan:=/typo_check/scan',
-                                 'map:=/typo_check/map', 'map_metadata:=/typo_check/map_metadata',
-                                 'dynamic_map:=/typo_check/dynamic_map'],
+                                 '_base_link:=base_footprint', '_base_frame:=tc_base', '_odom_frame:=tc_odom',
+                                 '_map_frame:=tc_map', '_map_update_interval:=0.1', '_temporalUpdate:=0.05',
+                                 'scan:=%s/scan' % ns, 'map:=%s/map' % ns, 'map_metadata:=%s/map_metadata' % ns,
+                                 'dynamic_map:=%s/dynamic_map' % ns],
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         lines = []
-        reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
-        reader.start()
-        deadline = time.time() + 30.0
-        while time.time() < deadline and not any('~base_link' in l for l in lines):
-            time.sleep(0.2)
-        proc.terminate()
-        proc.wait()
-        hits = [l for l in lines if '~base_link' in l]
-        self.assertTrue(hits, 'no warning about ~base_link; output: %s' % ''.join(lines))
-        self.assertIn('did you mean ~base_frame', hits[0])
+        threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True).start()
+
+        def printed(text, timeout=20.0):
+            deadline = time.time() + timeout
+            while time.time() < deadline:
+                if any(text in l for l in lines):
+                    return True
+                time.sleep(0.1)
+            return False
+
+        try:
+            self.assertTrue(printed('~base_link'), 'no warning about ~base_link: %s' % ''.join(lines))
+            self.assertIn('did you mean ~base_frame', next(l for l in lines if '~base_link' in l))
+            static = tf2_ros.StaticTransformBroadcaster()
+            tfs = []
+            for parent, child in (('tc_odom', 'tc_base'), ('tc_base', 'tc_laser')):
+                t = TransformStamped()
+                t.header.frame_id, t.child_frame_id = parent, child
+                t.transform.rotation.w = 1.0
+                tfs.append(t)
+            static.sendTransform(tfs)
+            pub = rospy.Publisher(ns + '/scan', LaserScan, queue_size=10)
+            rospy.sleep(1.0)
+
+            def scan(stamp, n=90, announced=90, ranges=None):
+                m = LaserScan()
+                m.header.stamp, m.header.frame_id = stamp, 'tc_laser'
+                m.angle_min, m.angle_increment = -math.pi / 2, math.pi / 90
+                m.angle_max = m.angle_min + (announced - 1) * m.angle_increment
+                m.range_min, m.range_max = 0.1, 10.0
+                m.ranges = ranges if ranges is not None else [2.0 + 0.01 * (i % 7) for i in range(n)]
+                return m
+
+            now = rospy.Time.now()
+            pub.publish(scan(now, n=60))  # fewer beams than angle_min..angle_max announce
+            self.assertTrue(printed('announce 90 beams but it has 60'), ''.join(lines))
+            rospy.sleep(6.0)  # the warning is throttled (5 s), as a flood of bad scans would be
+            bad = scan(now)
+            bad.angle_increment = float('nan')
+            pub.publish(bad)
+            self.assertTrue(printed('angle_increment'), ''.join(lines))
+            rospy.sleep(6.0)
+            pub.publish(scan(now, ranges=[float('nan')] * 90))
+            self.assertTrue(printed('none of its 90 ranges is usable'), ''.join(lines))
+            for k in range(5):  # good scans: the node builds a map from them
+                pub.publish(scan(now + rospy.Duration(0.1 * (k + 1))))
+                rospy.sleep(0.3)
+            rospy.wait_for_message(ns + '/map', OccupancyGrid, timeout=20.0)
+            pub.publish(scan(now - rospy.Duration(30.0)))  # a bag restarted
+            self.assertTrue(printed('time went backwards'), ''.join(lines))
+            self.assertIsNone(proc.poll(), 'slam_gmapping died on bad input')
+        finally:
+            proc.terminate()
+            proc.wait()
 
 
 if __name__ == '__main__':
