@@ -13,6 +13,7 @@ import tf2_ros
 from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.grid import OccupancyGrid
+from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
 def make_room(width_m: float, height_m: float, resolution_m: float) -> OccupancyGrid:
@@ -56,7 +57,7 @@ def main() -> None:
             rospy.logwarn_throttle(5.0, 'grid_laser: no transform from %s to %s: %s', frame_id, world_frame, e)
             continue
         t, q = tf.transform.translation, tf.transform.rotation
-        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        yaw = quaternion_to_yaw(q.x, q.y, q.z, q.w)
         ranges = room.cast_rays(t.x, t.y, angles_in_sensor + yaw, range_max)
         scan = LaserScan()
         scan.header.stamp = rospy.Time.now()

@@ -11,7 +11,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.msg import Contact, ModelState
-from mbot_slam_navigation.sim.transforms import quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.transforms import quaternion_to_yaw, yaw_to_quaternion
 from mbot_slam_navigation.srv import GetModelState, SetModelState, SpawnModel, SpawnModelRequest
 
 

@@ -19,7 +19,7 @@ from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, occupied_points
 from mbot_slam_navigation.sim.sdf_world import load_world
-from mbot_slam_navigation.sim.transforms import quaternion_to_yaw
+from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 # Around the living room twice (world frame, m): clear of the sofa, coffee table and plant.
 ROUTE = [(-1.0, -1.0), (-2.0, -2.8), (-4.2, -3.2), (-4.6, -1.5), (-3.0, -0.3), (0.0, -0.3), (0.3, -2.5),

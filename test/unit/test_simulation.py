@@ -2,7 +2,6 @@
 import math
 import os
 
-import numpy as np
 import pytest
 
 from mbot_slam_navigation.sim.sdf_world import load_world

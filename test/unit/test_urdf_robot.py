@@ -75,7 +75,7 @@ def test_shipped_robots_through_xacro():
 
 
 def test_wheel_joints_for_publish_wheel_tf():
-    from mbot_slam_navigation.sim.transforms import from_xyz_rpy, matrix_to_quaternion, quaternion_multiply
+    from mbot_slam_navigation.transforms import from_xyz_rpy, matrix_to_quaternion, quaternion_multiply
     mbot = parse_urdf(xacro(os.path.join(PKG, 'urdf', 'xacro', 'robot.xacro')))
     left, right = mbot.wheels
     assert (left.name, left.parent, left.child, left.side) == ('left_wheel_joint', 'base_link', 'left_wheel_link', 0)

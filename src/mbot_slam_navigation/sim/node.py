@@ -27,7 +27,7 @@ from tf2_msgs.msg import TFMessage
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.sim.sdf_world import World, load_world
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
-from mbot_slam_navigation.sim.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
+from mbot_slam_navigation.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
                                                  yaw_to_quaternion)
 from mbot_slam_navigation.sim.urdf_robot import parse_urdf
 from mbot_slam_navigation.sim.xmlutil import XmlError

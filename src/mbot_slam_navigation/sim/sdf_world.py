@@ -13,7 +13,7 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from mbot_slam_navigation.sim.transforms import from_xyz_rpy, planar
+from mbot_slam_navigation.transforms import from_xyz_rpy, planar
 from mbot_slam_navigation.sim.xmlutil import XmlError, child_text, floats, parse_xml, where
 
 SKIPPED_INCLUDES = ('model://ground_plane', 'model://sun')

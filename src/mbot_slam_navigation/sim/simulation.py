@@ -3,7 +3,6 @@
 All poses are (x [m], y [m], yaw [rad]) of base frames in the world frame; time is seconds of
 simulated time. The hot loops (ray casting, collision) run in the C++ core.
 """
-import math
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
@@ -12,7 +11,7 @@ import numpy as np
 
 from mbot_slam_navigation import _core
 from mbot_slam_navigation.sim.sdf_world import World
-from mbot_slam_navigation.sim.transforms import compose2d
+from mbot_slam_navigation.transforms import compose2d
 from mbot_slam_navigation.sim.urdf_robot import LaserSpec, RobotSpec
 
 Pose2D = Tuple[float, float, float]

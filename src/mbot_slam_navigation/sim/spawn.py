@@ -6,7 +6,7 @@ import rospy
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
-from mbot_slam_navigation.sim.transforms import yaw_to_quaternion
+from mbot_slam_navigation.transforms import yaw_to_quaternion
 from mbot_slam_navigation.srv import SpawnModel, SpawnModelRequest
 
 

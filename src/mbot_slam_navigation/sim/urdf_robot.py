@@ -15,11 +15,11 @@ Old tags (torque, wheelTorque, legacyMode, alwaysOn, rosDebugLevel, ...) are acc
 """
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
+from typing import Dict, List
 
 import numpy as np
 
-from mbot_slam_navigation.sim.transforms import convex_hull, from_xyz_rpy, planar
+from mbot_slam_navigation.transforms import convex_hull, from_xyz_rpy, planar
 from mbot_slam_navigation.sim.xmlutil import XmlError, child_text, floats, parse_xml, where
 
 DIFF_DRIVE = 'libgazebo_ros_diff_drive.so'

@@ -12,6 +12,9 @@ from typing import List, Tuple
 
 import numpy as np
 
+from mbot_slam_navigation.transforms import relative2d
+
+
 class CarmenError(ValueError):
     """A line that cannot be read; the message names the file and line."""
 
@@ -24,13 +27,6 @@ class Scan:
     angle_min: float                        # [rad]
     angle_increment: float                  # [rad]
     ranges: np.ndarray                      # float32 [m]
-
-
-def _relative(a, b):
-    """Pose b in the frame of pose a."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return c * dx + s * dy, -s * dx + c * dy, math.atan2(math.sin(b[2] - a[2]), math.cos(b[2] - a[2]))
 
 
 def read_log(path: str) -> List[Scan]:
@@ -50,7 +46,7 @@ def read_log(path: str) -> List[Scan]:
                     inc = math.pi / (n - 1) if n % 2 == 1 else math.pi / n
                     start = -math.pi / 2
                 else:
-                    start, fov, inc = float(parts[2]), float(parts[3]), float(parts[4])
+                    start, inc = float(parts[2]), float(parts[4])  # parts[3]: field of view
                     n = int(parts[8])
                     ranges = [float(v) for v in parts[9:9 + n]]
                     k = 9 + n
@@ -63,7 +59,7 @@ def read_log(path: str) -> List[Scan]:
                     raise ValueError('%d ranges announced, %d present' % (n, len(ranges)))
             except (ValueError, IndexError) as e:
                 raise CarmenError('%s:%d: cannot read %s line: %s' % (path, lineno, parts[0], e)) from None
-            scans.append(Scan(time=t, odom=tuple(odom), laser_pose=_relative(odom, laser), angle_min=start,
+            scans.append(Scan(time=t, odom=tuple(odom), laser_pose=relative2d(odom, laser), angle_min=start,
                               angle_increment=inc, ranges=np.asarray(ranges, dtype=np.float32)))
     if not scans:
         raise CarmenError('%s: no FLASER or ROBOTLASER1 lines' % path)

@@ -6,7 +6,6 @@ Usage: slam_offline LOG [-o OUT] [--relations FILE] [--param name=value ...] [--
 """
 import argparse
 import json
-import math
 import os
 import sys
 import time
@@ -17,17 +16,7 @@ from mbot_slam_navigation.maps.map_io import save_map
 from mbot_slam_navigation.slam.carmen import read_log
 from mbot_slam_navigation.slam.rbpf import GMAPPING_DEFAULTS, RbpfSlam
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
-
-
-def _compose(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], math.atan2(math.sin(a[2] + b[2]), math.cos(a[2] + b[2])))
-
-
-def _relative(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return (c * dx + s * dy, -s * dx + c * dy, b[2] - a[2])
+from mbot_slam_navigation.transforms import compose2d, quaternion_to_yaw, relative2d
 
 
 def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
@@ -37,7 +26,7 @@ def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
     for i, scan in enumerate(scans):
         k = max(0, int(np.searchsorted(times, scan.time, side='right')) - 1)
         node_pose, node_odom = trajectory[k, 1:4], trajectory[k, 4:7]
-        out[i] = _compose(node_pose, _relative(node_odom, scan.odom))
+        out[i] = compose2d(node_pose, relative2d(node_odom, scan.odom))
     return out
 
 
@@ -50,8 +39,7 @@ def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
         for topic, msg, _ in bag.read_messages(topics=[scan_topic, odom_topic]):
             if topic == odom_topic:
                 q = msg.pose.pose.orientation
-                odom = (msg.pose.pose.position.x, msg.pose.pose.position.y,
-                        math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+                odom = (msg.pose.pose.position.x, msg.pose.pose.position.y, quaternion_to_yaw(q.x, q.y, q.z, q.w))
             elif odom is not None:
                 scans.append(Scan(time=msg.header.stamp.to_sec(), odom=odom, laser_pose=(0.0, 0.0, 0.0),
                                   angle_min=msg.angle_min, angle_increment=msg.angle_increment,

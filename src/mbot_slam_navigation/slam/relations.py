@@ -8,9 +8,10 @@ lie within `max_gap` seconds of the relation's time.
 """
 import math
 from dataclasses import dataclass
-from typing import List, Tuple
 
 import numpy as np
+
+from mbot_slam_navigation.transforms import compose2d, inverse2d, relative2d
 
 
 @dataclass
@@ -42,16 +43,6 @@ def read_relations(path: str) -> np.ndarray:
     return np.array(rows)
 
 
-def _compose(a, b):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
-
-
-def _inverse(a):
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
-
-
 def pose_at(times: np.ndarray, poses: np.ndarray, t: float, max_gap: float = 0.1):
     """The pose at time t, interpolated; None when no estimate lies within max_gap of t."""
     i = int(np.searchsorted(times, t))
@@ -78,8 +69,7 @@ def evaluate(times: np.ndarray, poses: np.ndarray, relations: np.ndarray, max_ga
         if p1 is None or p2 is None:
             skipped += 1
             continue
-        est = _compose(_inverse(p1), p2)
-        err = _compose(est, _inverse(np.array([x, y, yaw])))
+        err = compose2d(relative2d(p1, p2), inverse2d((x, y, yaw)))
         trans.append(math.hypot(err[0], err[1]))
         rot.append(abs(math.degrees(math.atan2(math.sin(err[2]), math.cos(err[2])))))
     trans, rot = np.array(trans), np.array(rot)

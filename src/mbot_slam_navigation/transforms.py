@@ -1,4 +1,5 @@
-"""Rigid transforms as 4x4 numpy matrices (URDF/SDF xyz + roll-pitch-yaw), and their planar part."""
+"""Rigid transforms: 4x4 numpy matrices (URDF/SDF xyz + roll-pitch-yaw), planar poses (x, y, yaw),
+quaternions (x, y, z, w). Metres and radians."""
 import math
 from typing import Sequence, Tuple
 
@@ -23,10 +24,21 @@ def planar(t: np.ndarray) -> Tuple[float, float, float]:
 
 
 def compose2d(a: Sequence[float], b: Sequence[float]) -> Tuple[float, float, float]:
-    """Planar pose composition a (+) b."""
+    """Planar pose composition a (+) b: b given in a's frame, returned in a's parent frame."""
     c, s = math.cos(a[2]), math.sin(a[2])
     yaw = math.atan2(math.sin(a[2] + b[2]), math.cos(a[2] + b[2]))
     return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], yaw
+
+
+def inverse2d(a: Sequence[float]) -> Tuple[float, float, float]:
+    """The inverse planar pose: compose2d(a, inverse2d(a)) == (0, 0, 0)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return -c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]
+
+
+def relative2d(a: Sequence[float], b: Sequence[float]) -> Tuple[float, float, float]:
+    """Pose b expressed in the frame of pose a (inverse2d(a) (+) b)."""
+    return compose2d(inverse2d(a), b)
 
 
 def yaw_to_quaternion(yaw: float) -> Tuple[float, float, float, float]:
