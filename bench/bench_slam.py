@@ -46,6 +46,9 @@ def main():
         save_map(os.path.join(OUT, name), data, res, (origin[0], origin[1], 0.0))
         write_png(os.path.join(OUT, name + '.png'), data)
         duration = scans[-1].time - scans[0].time
+        held, unshared = slam.map_memory()
+        print(json.dumps(dict(benchmark='slam', metric='%s memory of the 30 particle maps' % name,
+                              value=held / 2 ** 20, unit='MB', note='%.0f MB if no patch were shared' % (unshared / 2 ** 20))))
         print('%s: %d scans, %d filter updates, %.1f CPU s for %.0f s of log; map in %s'
               % (name, len(scans), slam.updates, cpu, duration, os.path.join(OUT, name + '.png')), flush=True)
         print(json.dumps(dict(benchmark='slam', metric='%s CPU time' % name, value=cpu, unit='s',

@@ -264,12 +264,15 @@ PYBIND11_MODULE(_core, m) {
         for (const auto& p : s.particles()) out.push_back(p.pose);
         return out;
       })
-      .def("shared_patch_stats", [](const RbpfSlam& s) {
-        long owned = 0, allocated = 0;
+      .def("map_memory", [](const RbpfSlam& s) {
+        // (bytes of distinct patches held by all particles, bytes if none were shared)
+        std::unordered_set<const void*> distinct;
+        long referenced = 0;
         for (const auto& p : s.particles()) {
-          owned += p.map.ownedPatches();
-          allocated += p.map.allocatedPatches();
+          p.map.collectPatches(distinct);
+          referenced += p.map.allocatedPatches();
         }
-        return py::make_tuple(owned, allocated);
+        return py::make_tuple(distinct.size() * mbot::core::SlamGrid::kPatchBytes,
+                              referenced * mbot::core::SlamGrid::kPatchBytes);
       });
 }

@@ -126,6 +126,12 @@ int SlamGrid::ownedPatches() const {
   return n;
 }
 
+void SlamGrid::collectPatches(std::unordered_set<const void*>& out) const {
+  for (const auto& p : patches_) {
+    if (p) out.insert(p.get());
+  }
+}
+
 int SlamGrid::allocatedPatches() const {
   int n = 0;
   for (const auto& p : patches_) n += p != nullptr;

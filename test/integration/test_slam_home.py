@@ -15,6 +15,7 @@ import rostest
 import tf2_ros
 from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import OccupancyGrid, Odometry
+from nav_msgs.srv import GetMap
 from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, occupied_points
@@ -81,6 +82,9 @@ class SlamHomeTest(unittest.TestCase):
         # Occupied cells are 5 cm squares whose centres lie up to half a diagonal off the surface.
         self.assertLess(np.percentile(d, 95), 0.1, 'walls off the true walls: 95th percentile %.3f m' % np.percentile(d, 95))
         self.assertLess(np.median(d), 0.05)
+        served = rospy.ServiceProxy('/dynamic_map', GetMap)().map
+        self.assertEqual((served.info.width, served.info.height), (msg.info.width, msg.info.height))
+        self.assertEqual(served.header.frame_id, 'map')
 
     def test_tutorial_typo_and_bad_scans_get_warnings(self):
         # A second instance, started as the tutorial does (~base_link, a typo for ~base_frame), in

@@ -52,3 +52,54 @@ def test_relations_metric():
     e = evaluate(times, np.array(stretched), rel)
     assert e.trans_mean == pytest.approx(0.1, abs=0.01) and e.count == len(rel)
     assert pose_at(times, poses, 100.0) is None  # no estimate near that time
+
+
+def test_slam_offline_on_a_rosbag(tmp_path):
+    """A bag recorded from the simulator's topics (/scan, /odom) goes through slam_offline."""
+    import rosbag
+    import rospy
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import LaserScan
+
+    from mbot_slam_navigation.sim.sdf_world import World, Shape
+    from mbot_slam_navigation.sim.simulation import Simulation
+    from mbot_slam_navigation.slam.offline import main
+    from mbot_slam_navigation.transforms import yaw_to_quaternion
+    from test_simulation import robot_spec
+
+    world = World('room', [Shape('box', 0, 3.05, 0, 8.2, 0.1), Shape('box', 0, -3.05, 0, 8.2, 0.1),
+                           Shape('box', 4.05, 0, 0, 0.1, 6.2), Shape('box', -4.05, 0, 0, 0.1, 6.2),
+                           Shape('box', 1.5, 1.0, 0.4, 0.6, 0.6), Shape('circle', -1.0, 1.5, radius=0.3)])
+    sim = Simulation(world, slip_stddev=0.02, seed=1)
+    robot = sim.spawn('r', robot_spec(), (-2.5, -1.0, 0.0))
+    bag_path = str(tmp_path / 'drive.bag')
+    with rosbag.Bag(bag_path, 'w') as bag:
+        for step in range(1500):  # 15 s: forward, a turn, forward
+            sim.command('r', 0.3, 0.4 if 500 <= step < 800 else 0.0)
+            sim.step()
+            stamp = rospy.Time.from_sec(sim.time)
+            if step % 5 == 0:
+                odom = Odometry()
+                odom.header.stamp = stamp
+                ox, oy, oyaw = robot.drive.odom_pose
+                odom.pose.pose.position.x, odom.pose.pose.position.y = ox, oy
+                (odom.pose.pose.orientation.x, odom.pose.pose.orientation.y, odom.pose.pose.orientation.z,
+                 odom.pose.pose.orientation.w) = yaw_to_quaternion(oyaw)
+                bag.write('/odom', odom, stamp)
+            if step % 10 == 0:
+                s = robot.lasers[0].spec
+                scan = LaserScan()
+                scan.header.stamp, scan.header.frame_id = stamp, 'laser'
+                scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max = \
+                    s.angle_min, s.angle_increment, s.range_min, s.range_max
+                scan.ranges = sim.scan(robot, robot.lasers[0]).tolist()
+                bag.write('/scan', scan, stamp)
+    out = str(tmp_path / 'drive')
+    assert main([bag_path, '-o', out, '--quiet', '--param', 'particles=5', '--param', 'maxUrange=9.5',
+                 '--param', 'maxRange=10', '--param', 'linearUpdate=0.2', '--param', 'angularUpdate=0.2']) == 0
+    traj = np.loadtxt(out + '.traj')
+    assert traj.shape[1] == 4 and len(traj) == 150
+    # The map frame starts at the first odometry pose (the spawn pose's odom is 0): compare motion.
+    true_motion = relative2d((-2.5, -1.0, 0.0), robot.pose)
+    assert np.hypot(traj[-1, 1] - true_motion[0], traj[-1, 2] - true_motion[1]) < 0.1
+    assert os.path.exists(out + '.pgm') and os.path.exists(out + '.yaml')

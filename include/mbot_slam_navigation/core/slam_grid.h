@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,6 +80,9 @@ class SlamGrid {
   /// Patches allocated by this grid alone (not shared with any other grid) and in all.
   int ownedPatches() const;
   int allocatedPatches() const;
+  /// Adds the addresses of this grid's patches to `out` (to count distinct patches across grids).
+  void collectPatches(std::unordered_set<const void*>& out) const;
+  static constexpr std::size_t kPatchBytes = kPatchSize * kPatchSize * sizeof(HitCell);
 
  private:
   struct Patch {

@@ -12,6 +12,7 @@ unpause_physics, reset_simulation, reset_world; topic <ns>/contacts (mbot_slam_n
 Message stamps are simulated time; the node itself paces on the wall clock.
 """
 import math
+import os
 import threading
 import time
 import warnings
@@ -128,7 +129,10 @@ class SimNode:
         rospy.Service(s + 'reset_simulation', Empty, self.on_reset)
         rospy.Service(s + 'reset_world', Empty, self.on_reset)
         self.viewer = None
-        if self.gui:
+        if self.gui and not os.environ.get('DISPLAY'):
+            rospy.logwarn('gazebo_sim: gui:=true but there is no display (DISPLAY is unset): running headless; '
+                          'pass gui:=false to silence this')
+        elif self.gui:
             from mbot_slam_navigation.sim.viewer import TopDownViewer
             self.viewer = TopDownViewer(world)
 

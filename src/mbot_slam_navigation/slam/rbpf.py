@@ -75,5 +75,6 @@ class RbpfSlam:
     def resamples(self) -> int:
         return self._impl.resamples
 
-    def shared_patch_stats(self):
-        return self._impl.shared_patch_stats()
+    def map_memory(self) -> Tuple[int, int]:
+        """(bytes the particles' maps hold, bytes they would hold if no patch were shared)."""
+        return self._impl.map_memory()
