@@ -64,3 +64,9 @@ def test_shipped_worlds_load_without_warnings():
     assert home.warnings == [] and len(home.shapes) >= 30
     wall = load_world(os.path.join(PKG, 'worlds', 'wall.world'))
     assert wall.warnings == []
+
+
+def test_bounds_of_the_home():
+    xmin, ymin, xmax, ymax = load_world(os.path.join(PKG, 'worlds', 'mbot_sim_gazebo_navigation.world')).bounds()
+    # Outer wall faces: balcony west wall x = -7.5 - 0.05, east x = 4.5 + 0.05, south y = -6.05, north 3.65.
+    assert (xmin, ymin, xmax, ymax) == pytest.approx((-7.6, -6.1, 4.6, 3.7), abs=0.06)

@@ -44,8 +44,12 @@ class World:
             return None
         pts = []
         for s in self.shapes:
-            r = s.radius if s.kind == 'circle' else 0.5 * math.hypot(s.size_x, s.size_y)
-            pts += [(s.x - r, s.y - r), (s.x + r, s.y + r)]
+            if s.kind == 'circle':
+                pts += [(s.x - s.radius, s.y - s.radius), (s.x + s.radius, s.y + s.radius)]
+                continue
+            c, si = math.cos(s.yaw), math.sin(s.yaw)
+            pts += [(s.x + c * a * s.size_x / 2 - si * b * s.size_y / 2, s.y + si * a * s.size_x / 2 + c * b * s.size_y / 2)
+                    for a in (-1, 1) for b in (-1, 1)]
         a = np.array(pts)
         return tuple(a.min(axis=0)) + tuple(a.max(axis=0))
 
