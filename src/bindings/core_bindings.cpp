@@ -8,7 +8,9 @@
 
 #include "mbot_slam_navigation/core/bresenham.h"
 #include "mbot_slam_navigation/core/diff_drive.h"
+#include "mbot_slam_navigation/core/costmap.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
+#include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "mbot_slam_navigation/core/world2d.h"
@@ -275,4 +277,26 @@ PYBIND11_MODULE(_core, m) {
         return py::make_tuple(distinct.size() * mbot::core::SlamGrid::kPatchBytes,
                               referenced * mbot::core::SlamGrid::kPatchBytes);
       });
+
+  // --- Costmaps ----------------------------------------------------------------------------------
+  m.def(
+      "_inflate",
+      [](py::array_t<uint8_t, py::array::c_style> costs, double resolution, double inscribed_radius,
+         double inflation_radius, double cost_scaling_factor, bool inflate_unknown) {
+        if (costs.ndim() != 2) throw std::invalid_argument("costs must be a 2D array (rows = y)");
+        mbot::core::Costmap map(static_cast<int>(costs.shape(1)), static_cast<int>(costs.shape(0)), resolution, {0, 0});
+        std::copy(costs.data(), costs.data() + costs.size(), map.costs().begin());
+        mbot::core::InflationParams p;
+        p.inscribed_radius = inscribed_radius;
+        p.inflation_radius = inflation_radius;
+        p.cost_scaling_factor = cost_scaling_factor;
+        p.inflate_unknown = inflate_unknown;
+        {
+          py::gil_scoped_release release;
+          mbot::core::inflate(map, p);
+        }
+        std::copy(map.costs().begin(), map.costs().end(), costs.mutable_data());
+      },
+      py::arg("costs"), py::arg("resolution"), py::arg("inscribed_radius"), py::arg("inflation_radius"),
+      py::arg("cost_scaling_factor"), py::arg("inflate_unknown") = false);
 }

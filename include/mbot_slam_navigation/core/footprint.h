@@ -1,0 +1,37 @@
+// Robot footprints as costmap_2d uses them: a polygon in the robot base frame [m] (or a circle of
+// robot_radius, as a 16-gon), padded outwards by footprint_padding; its inscribed radius (centre to
+// the nearest edge) sets the inflation layer's 253 band, its circumscribed radius (centre to the
+// farthest vertex) the planners' worst case.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/costmap.h"
+
+namespace mbot {
+namespace core {
+
+using Footprint = std::vector<Eigen::Vector2d>;
+
+/// A circle of `radius_m` as a 16-gon whose edges touch the circle from outside.
+Footprint circleFootprint(double radius_m);
+/// Each vertex moved `padding_m` away from the centre along its own direction (costmap_2d's rule).
+Footprint padFootprint(const Footprint& footprint, double padding_m);
+/// Distance [m] from the origin to the nearest edge / farthest vertex.
+double inscribedRadius(const Footprint& footprint);
+double circumscribedRadius(const Footprint& footprint);
+/// Throws std::invalid_argument when the polygon has fewer than 3 vertices or does not contain
+/// the origin (the robot's centre must lie inside its footprint).
+void validateFootprint(const Footprint& footprint);
+
+/// The highest cost under the footprint's outline at `pose` (x, y, yaw; costmap frame) as
+/// base_local_planner's CostmapModel checks it: -1 when any outline cell is lethal (254) or
+/// outside the map, else the maximum over the outline cells (unknown cells count as 255 only if
+/// `unknown_is_obstacle`, else are ignored).
+int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint,
+                  bool unknown_is_obstacle = false);
+
+}  // namespace core
+}  // namespace mbot

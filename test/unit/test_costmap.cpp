@@ -1,0 +1,90 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/footprint.h"
+#include "mbot_slam_navigation/core/inflation_layer.h"
+
+using namespace mbot::core;
+
+TEST(Costmap, OccupancyGridValuesAsCostmap2dPublishesThem) {
+  Costmap m(6, 1, 0.05, {0, 0});
+  const uint8_t in[6] = {0, 1, 128, 252, 253, 254};
+  for (int x = 0; x < 6; ++x) m.setCost({x, 0}, in[x]);
+  const auto out = m.toOccupancyData();
+  EXPECT_EQ(out[0], 0);
+  EXPECT_EQ(out[1], 1);
+  EXPECT_GT(out[2], 1);
+  EXPECT_LT(out[2], 98);
+  EXPECT_EQ(out[3], 98);
+  EXPECT_EQ(out[4], 99);
+  EXPECT_EQ(out[5], 100);
+  m.setCost({0, 0}, cost::kNoInformation);
+  EXPECT_EQ(m.toOccupancyData()[0], -1);
+  EXPECT_EQ(costFromOccupancy(100), cost::kLethal);
+  EXPECT_EQ(costFromOccupancy(-1), cost::kNoInformation);
+  EXPECT_EQ(costFromOccupancy(-1, 100, false), cost::kFree);
+  EXPECT_EQ(costFromOccupancy(65), cost::kFree);
+}
+
+TEST(Costmap, RollingWindowKeepsOverlappingCells) {
+  Costmap m(10, 10, 0.1, {0, 0});
+  m.setCost({5, 5}, 200);
+  m.moveOrigin({0.3, -0.2});
+  EXPECT_NEAR(m.origin().x(), 0.3, 1e-9);
+  EXPECT_EQ(m.cost({2, 7}), 200);  // the same world cell, new index
+  EXPECT_EQ(m.cost({9, 0}), cost::kNoInformation);
+}
+
+TEST(Inflation, ValuesFollowTheCostmap2dFormula) {
+  InflationParams p;
+  p.inscribed_radius = 0.2;
+  p.inflation_radius = 0.6;
+  p.cost_scaling_factor = 10.0;
+  Costmap m(101, 101, 0.05, {0, 0});
+  m.setCost({50, 50}, cost::kLethal);
+  inflate(m, p);
+  EXPECT_EQ(m.cost({50, 50}), cost::kLethal);
+  EXPECT_EQ(m.cost({54, 50}), cost::kInscribed);  // 0.20 m: inscribed
+  for (int k = 5; k <= 12; ++k) {                 // 0.25 .. 0.60 m along x
+    const double d = k * 0.05;
+    EXPECT_EQ(m.cost({50 + k, 50}), static_cast<uint8_t>(252 * std::exp(-10.0 * (d - 0.2)))) << d;
+  }
+  EXPECT_EQ(m.cost({50 + 13, 50}), 0);  // beyond the inflation radius
+  // Diagonal: exact Euclidean distance (0.35 m * sqrt 2 = 0.495 m)
+  EXPECT_EQ(m.cost({57, 57}), static_cast<uint8_t>(252 * std::exp(-10.0 * (0.35 * std::sqrt(2.0) - 0.2))));
+}
+
+TEST(Inflation, UnknownCellsOnlyTakeInscribedCostsByDefault) {
+  InflationParams p;
+  Costmap m(40, 1, 0.05, {0, 0}, cost::kNoInformation);
+  m.setCost({0, 0}, cost::kLethal);
+  inflate(m, p);
+  EXPECT_EQ(m.cost({2, 0}), cost::kInscribed);        // 0.10 m <= inscribed 0.2
+  EXPECT_EQ(m.cost({6, 0}), cost::kNoInformation);    // 0.30 m: inflated cost < 253 keeps unknown
+  p.inflate_unknown = true;
+  inflate(m, p);
+  EXPECT_LT(m.cost({6, 0}), cost::kInscribed);
+}
+
+TEST(Footprint, RadiiPaddingAndCollision) {
+  const Footprint square{{-0.2, -0.2}, {-0.2, 0.2}, {0.2, 0.2}, {0.2, -0.2}};  // the tutorial's car
+  EXPECT_NEAR(inscribedRadius(square), 0.2, 1e-12);
+  EXPECT_NEAR(circumscribedRadius(square), 0.2 * std::sqrt(2.0), 1e-12);
+  const Footprint padded = padFootprint(square, 0.05);
+  EXPECT_NEAR(circumscribedRadius(padded), 0.2 * std::sqrt(2.0) + 0.05, 1e-12);
+  const Footprint circle = circleFootprint(0.2);
+  EXPECT_NEAR(inscribedRadius(circle), 0.2, 1e-9);
+  EXPECT_THROW(validateFootprint({{1, 1}, {2, 1}, {2, 2}}), std::invalid_argument);  // centre outside
+  EXPECT_NO_THROW(validateFootprint(square));
+
+  Costmap m(100, 100, 0.05, {0, 0});
+  for (int y = 0; y < 100; ++y) m.setCost({70, y}, cost::kLethal);  // a wall at x = 3.5 m
+  EXPECT_EQ(footprintCost(m, {2.5, 2.5, 0.0}, square), 0);
+  EXPECT_EQ(footprintCost(m, {3.35, 2.5, 0.0}, square), -1);  // the front edge reaches the wall
+  // Turned 45 degrees, the corner reaches further: 0.28 m instead of 0.2 m.
+  EXPECT_EQ(footprintCost(m, {3.25, 2.5, 0.0}, square), 0);
+  EXPECT_EQ(footprintCost(m, {3.25, 2.5, M_PI / 4}, square), -1);
+  EXPECT_EQ(footprintCost(m, {0.1, 2.5, 0.0}, square), -1);  // partly off the map
+}
