@@ -1,8 +1,15 @@
 #!/usr/bin/env python3
-"""Costmap benchmark: inflation of a full 4000 x 4000 costmap at 0.05 m (an office-like maze of
-rooms and corridors), the tutorial's inflation (inflation_radius 0.6 m, cost_scaling_factor 10,
-inscribed radius 0.2 m). Median of 5 runs, one core, through the binding (which copies the 16 MB
-grid in and out: included). Target: under 100 ms.
+"""Costmap and global planner benchmark (issue: move_base).
+
+- Inflation of a full 4000 x 4000 costmap at 0.05 m (an office-like maze of 5 m rooms with 1 m
+  doors), the tutorial's inflation (inflation_radius 0.6 m, cost_scaling_factor 10, inscribed radius
+  0.2 m). Median of 5, one core, through the binding (copying the 16 MB grid in and out: included).
+  Target: under 100 ms.
+- Global plans (navfn-style Dijkstra and A*) on 1000 x 1000 and 4000 x 4000 inflated maps at 0.05 m
+  (the maze and an open floor), corner to corner and a 3 m path; median of 3, one core, binding
+  overhead included (the costmap and planner objects persist, as in a node). For scale, ROS's navfn here: 4000 x 4000 corner to corner about 650 ms, a 3 m
+  plan on it about 110 ms, 1000 x 1000 maze corner to corner about 38 ms. Targets: 4000 x 4000
+  corner to corner under 200 ms, a 3 m plan under 5 ms.
 """
 import json
 import statistics
@@ -28,6 +35,41 @@ def office_maze(n=4000, room=100, door=20, seed=0):
     return g
 
 
+def median_ms(fn, runs):
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - t0)
+    return 1000 * statistics.median(times), result
+
+
+def plans():
+    for n in (1000, 4000):
+        for kind in ('maze', 'open'):
+            g = office_maze(n) if kind == 'maze' else np.zeros((n, n), np.uint8)
+            if kind == 'open':
+                g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = 254
+            _core._inflate(g, 0.05, 0.2, 0.6, 10.0)
+            size = n * 0.05
+            costmap = _core._Costmap(g, 0.05, np.zeros(2))
+            room = 5.0 * np.floor(size / 2 / 5.0)  # a room's corner near the middle
+            # corners: inside the first and last room, clear of the walls' inflation; 3 m: across a room
+            cases = [('corner to corner', (2.5, 2.5), (size - 2.4, size - 2.4)),
+                     ('3 m', (room + 1.2, room + 1.2), (room + 3.3, room + 3.3))]
+            for label, start, goal in cases:
+                for astar in (False, True):
+                    planner = _core._GlobalPlanner(use_astar=astar)
+                    ms, (status, path, message, expanded) = median_ms(
+                        lambda: planner.make_plan(costmap, np.array(start), np.array(goal)), 3)
+                    name = 'A*' if astar else 'Dijkstra'
+                    target = ('< 200' if label == 'corner to corner' else '< 5') if n == 4000 else ''
+                    print(json.dumps(dict(benchmark='planner', metric='%s %dx%d %s %s' % (name, n, n, kind, label),
+                                          value=ms, unit='ms', target=target,
+                                          note='%s, %d cells expanded, %d poses' % (status, expanded, len(path)))),
+                          flush=True)
+
+
 def main():
     maze = office_maze()
     times = []
@@ -38,6 +80,7 @@ def main():
         times.append(time.perf_counter() - t0)
     print(json.dumps(dict(benchmark='costmap', metric='inflation 4000x4000 at 0.05 m', value=1000 * statistics.median(times),
                           unit='ms', target='< 100', note='median of 5, office maze, radius 0.6 m')))
+    plans()
 
 
 if __name__ == '__main__':

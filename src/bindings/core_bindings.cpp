@@ -9,6 +9,7 @@
 #include "mbot_slam_navigation/core/bresenham.h"
 #include "mbot_slam_navigation/core/diff_drive.h"
 #include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
@@ -299,4 +300,54 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("costs"), py::arg("resolution"), py::arg("inscribed_radius"), py::arg("inflation_radius"),
       py::arg("cost_scaling_factor"), py::arg("inflate_unknown") = false);
+
+  using mbot::core::Costmap;
+  py::class_<Costmap>(m, "_Costmap")
+      .def(py::init([](const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& costs, double resolution,
+                       const Eigen::Vector2d& origin) {
+             if (costs.ndim() != 2) throw std::invalid_argument("costs must be a 2D array (rows = y)");
+             auto map = std::make_unique<Costmap>(static_cast<int>(costs.shape(1)), static_cast<int>(costs.shape(0)),
+                                                  resolution, origin);
+             std::copy(costs.data(), costs.data() + costs.size(), map->costs().begin());
+             return map;
+           }),
+           py::arg("costs"), py::arg("resolution"), py::arg("origin"))
+      .def("costs", [](const Costmap& c) {
+        py::array_t<uint8_t> out({c.height(), c.width()});
+        std::copy(c.costs().begin(), c.costs().end(), out.mutable_data());
+        return out;
+      })
+      .def("occupancy_data", [](const Costmap& c) {
+        const auto d = c.toOccupancyData();
+        py::array_t<int8_t> out({c.height(), c.width()});
+        std::copy(d.begin(), d.end(), out.mutable_data());
+        return out;
+      });
+  using mbot::core::GlobalPlanner;
+  py::class_<GlobalPlanner>(m, "_GlobalPlanner")
+      .def(py::init([](bool use_astar, bool allow_unknown, double default_tolerance) {
+             mbot::core::PlannerParams p;
+             p.use_astar = use_astar;
+             p.allow_unknown = allow_unknown;
+             p.default_tolerance = default_tolerance;
+             return std::make_unique<GlobalPlanner>(p);
+           }),
+           py::arg("use_astar") = false, py::arg("allow_unknown") = true, py::arg("default_tolerance") = 0.0)
+      .def(
+          "make_plan",
+          [](GlobalPlanner& planner, const Costmap& map, const Eigen::Vector2d& start, const Eigen::Vector2d& goal) {
+            mbot::core::Plan plan;
+            {
+              py::gil_scoped_release release;
+              plan = planner.makePlan(map, start, goal);
+            }
+            py::array_t<double> path({static_cast<py::ssize_t>(plan.path.size()), static_cast<py::ssize_t>(2)});
+            auto out = path.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < plan.path.size(); ++i) {
+              out(i, 0) = plan.path[i].x();
+              out(i, 1) = plan.path[i].y();
+            }
+            return py::make_tuple(std::string(mbot::core::toString(plan.status)), path, plan.message, plan.expanded);
+          },
+          py::arg("costmap"), py::arg("start"), py::arg("goal"));
 }

@@ -1,0 +1,83 @@
+// Global planning on a costmap, as navfn does it and with an A* option.
+//
+// Every traversable cell costs neutral_cost + cost_factor * its costmap value (navfn: 50 + 0.8 c);
+// cells at 253 (inscribed) or 254 (lethal) are obstacles, 255 (unknown) costs 253 when
+// allow_unknown and is an obstacle otherwise.
+// - Dijkstra (use_astar false): navfn's wavefront from the goal with its quadratic potential update
+//   (the potential at a cell interpolates between its two smallest 4-neighbours, approximating the
+//   continuous distance field), stopped once the start is reached; the path descends the potential
+//   from the start, to the neighbour (8-connected) of lowest potential.
+// - A* (use_astar true): 8-connected search from the start with the euclidean distance times
+//   neutral_cost as heuristic (admissible: no cell costs less).
+// Failures are typed (Nav2's StartOccupied, GoalOccupied, NoValidPathCouldBeFound...), never an
+// empty path without a reason.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/costmap.h"
+
+namespace mbot {
+namespace core {
+
+enum class PlanStatus { kOk, kStartOffMap, kGoalOffMap, kStartOccupied, kGoalOccupied, kNoPath };
+const char* toString(PlanStatus status);
+
+struct PlannerParams {
+  bool use_astar = false;
+  bool allow_unknown = true;       ///< navfn `allow_unknown`
+  double default_tolerance = 0.0;  ///< [m] a blocked goal moves to the nearest free cell this close
+  double neutral_cost = 50.0;
+  double cost_factor = 0.8;
+};
+
+struct Plan {
+  PlanStatus status = PlanStatus::kNoPath;
+  std::vector<Eigen::Vector2d> path;  ///< cell centres [m] from start to goal, costmap frame
+  Eigen::Vector2d goal = Eigen::Vector2d::Zero();  ///< the goal actually used (after tolerance)
+  std::string message;                ///< why, for a failure
+  int expanded = 0;                   ///< cells the search finalized
+};
+
+class GlobalPlanner {
+ public:
+  explicit GlobalPlanner(const PlannerParams& params = PlannerParams());
+  const PlannerParams& params() const { return params_; }
+  /// Plans on `map` (start and goal in its frame, m). Work is proportional to the cells the search
+  /// touches, not to the map: buffers persist between calls and are invalidated by a generation
+  /// stamp instead of being cleared (navfn copies and clears the whole costmap on every call).
+  Plan makePlan(const Costmap& map, const Eigen::Vector2d& start, const Eigen::Vector2d& goal);
+  /// The last search's value at cell index i (Dijkstra: potential; A*: cost from the start); +inf
+  /// where the search did not reach.
+  float valueAt(std::size_t i) const { return stamp_[i] == generation_ ? value_[i] : kUnreached; }
+
+ private:
+  static constexpr float kUnreached = std::numeric_limits<float>::infinity();
+  float cellCost(int i) const { return i == start_ ? start_cost_ : cost_of_value_[(*costs_)[i]]; }
+  float value(int i) const { return valueAt(static_cast<std::size_t>(i)); }
+  void setValue(int i, float v) {
+    stamp_[i] = generation_;
+    value_[i] = v;
+  }
+  bool search(const Costmap& map, int start, int goal, Plan& plan);
+  bool searchAStar(const Costmap& map, int start, int goal, Plan& plan);
+
+  PlannerParams params_;
+  float cost_of_value_[256];
+  float start_cost_ = 0.0f;
+  int start_ = -1;
+  const std::vector<uint8_t>* costs_ = nullptr;
+  std::vector<float> value_;
+  std::vector<uint32_t> stamp_;   // == generation_: value_ and the done flag are from this search
+  std::vector<uint8_t> done_;
+  std::vector<int> parent_;
+  uint32_t generation_ = 0;
+};
+
+}  // namespace core
+}  // namespace mbot
