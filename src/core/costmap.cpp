@@ -17,14 +17,9 @@ Costmap::Costmap(int width, int height, double resolution_m, const Eigen::Vector
   costs_.assign(static_cast<std::size_t>(width) * height, fill);
 }
 
-Cell Costmap::worldToCell(const Eigen::Vector2d& p) const {
-  return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
-              static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
-}
+Cell Costmap::worldToCell(const Eigen::Vector2d& p) const { return core::worldToCell(origin_, resolution_, p); }
 
-Eigen::Vector2d Costmap::cellCenter(const Cell& c) const {
-  return origin_ + Eigen::Vector2d(c.x + 0.5, c.y + 0.5) * resolution_;
-}
+Eigen::Vector2d Costmap::cellCenter(const Cell& c) const { return core::cellCenter(origin_, resolution_, c); }
 
 void Costmap::fill(uint8_t v) { std::fill(costs_.begin(), costs_.end(), v); }
 

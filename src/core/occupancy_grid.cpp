@@ -44,14 +44,9 @@ OccupancyGrid::OccupancyGrid(int width_cells, int height_cells, double resolutio
   observed_.assign(log_odds_.size(), 0);
 }
 
-Cell OccupancyGrid::worldToCell(const Eigen::Vector2d& p) const {
-  return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
-              static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
-}
+Cell OccupancyGrid::worldToCell(const Eigen::Vector2d& p) const { return core::worldToCell(origin_, resolution_, p); }
 
-Eigen::Vector2d OccupancyGrid::cellCenter(const Cell& c) const {
-  return origin_ + Eigen::Vector2d(c.x + 0.5, c.y + 0.5) * resolution_;
-}
+Eigen::Vector2d OccupancyGrid::cellCenter(const Cell& c) const { return core::cellCenter(origin_, resolution_, c); }
 
 void OccupancyGrid::checkContains(const Cell& c) const {
   if (!contains(c)) {

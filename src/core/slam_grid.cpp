@@ -23,10 +23,6 @@ SlamGrid::SlamGrid(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m, d
   patches_.assign(static_cast<std::size_t>(patches_x_) * patches_y_, nullptr);
 }
 
-Eigen::Vector2d SlamGrid::cellCenter(const Cell& c) const {
-  return origin_ + Eigen::Vector2d(c.x + 0.5, c.y + 0.5) * resolution_;
-}
-
 Eigen::Vector2d SlamGrid::hitMean(const Cell& c) const {
   const HitCell& h = cell(c);
   Eigen::Vector2d centre = cellCenter(c);

@@ -17,16 +17,27 @@ core::LaserScan fromRos(const sensor_msgs::LaserScan& msg) {
   return scan;
 }
 
+namespace {
+void fillInfo(int width, int height, double resolution, const Eigen::Vector2d& origin, nav_msgs::MapMetaData& info) {
+  info.resolution = static_cast<float>(resolution);
+  info.width = width;
+  info.height = height;
+  info.origin.position.x = origin.x();
+  info.origin.position.y = origin.y();
+  info.origin.position.z = 0.0;
+  info.origin.orientation.w = 1.0;
+}
+}  // namespace
+
 void toRos(const core::OccupancyGrid& grid, nav_msgs::OccupancyGrid& out) {
-  out.info.resolution = static_cast<float>(grid.resolution());
-  out.info.width = grid.width();
-  out.info.height = grid.height();
-  out.info.origin.position.x = grid.origin().x();
-  out.info.origin.position.y = grid.origin().y();
-  out.info.origin.position.z = 0.0;
-  out.info.origin.orientation.w = 1.0;
+  fillInfo(grid.width(), grid.height(), grid.resolution(), grid.origin(), out.info);
   const std::vector<int8_t> data = grid.toRosData();
   out.data.assign(data.begin(), data.end());
+}
+
+void toRos(const core::OccupancyImage& image, nav_msgs::OccupancyGrid& out) {
+  fillInfo(image.width, image.height, image.resolution, image.origin, out.info);
+  out.data.assign(image.data.begin(), image.data.end());
 }
 
 std::string describeScanProblem(const sensor_msgs::LaserScan& msg) {

@@ -9,6 +9,7 @@
 
 #include "mbot_slam_navigation/core/laser_scan.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
+#include "mbot_slam_navigation/core/slam_grid.h"
 
 namespace mbot {
 namespace ros_glue {
@@ -18,6 +19,7 @@ core::LaserScan fromRos(const sensor_msgs::LaserScan& msg);
 
 /// Fills `out` (data, info) from a grid; the caller sets the header (frame, stamp).
 void toRos(const core::OccupancyGrid& grid, nav_msgs::OccupancyGrid& out);
+void toRos(const core::OccupancyImage& image, nav_msgs::OccupancyGrid& out);
 
 /// Empty when the scan's header and ranges are consistent, else a sentence saying what is wrong
 /// (NaN or inf in the beam geometry, range_max <= range_min, no beams, fewer or more beams than

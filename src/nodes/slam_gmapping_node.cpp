@@ -195,14 +195,7 @@ class SlamGmappingNode {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!slam_) return;
-      const auto img = slam_->best().map.toOccupancy(occ_thresh_);
-      map.info.width = img.width;
-      map.info.height = img.height;
-      map.info.resolution = static_cast<float>(img.resolution);
-      map.info.origin.position.x = img.origin.x();
-      map.info.origin.position.y = img.origin.y();
-      map.info.origin.orientation.w = 1.0;
-      map.data.assign(img.data.begin(), img.data.end());
+      mbot::ros_glue::toRos(slam_->best().map.toOccupancy(occ_thresh_), map);
     }
     map.header.frame_id = map_frame_;
     map.header.stamp = stamp;

@@ -31,7 +31,7 @@ struct RbpfParams {
   double angular_update = 0.5;      ///< [rad] `angularUpdate`
   double temporal_update = -1.0;    ///< [s] `temporalUpdate`; < 0 disables
   double resample_threshold = 0.5;  ///< `resampleThreshold` (fraction of particles)
-  double ogain = 3.0;               ///< `ogain`: weights are exp(l / (ogain * particles))... see .cpp
+  double ogain = 3.0;               ///< `ogain`: weights are exp((l - l_max) / (ogain * particles))
   double minimum_score = 0.0;       ///< `minimumScore`: a worse match keeps the odometry pose
   double llsamplerange = 0.01, llsamplestep = 0.01;   ///< [m] proposal sampling in x, y
   double lasamplerange = 0.005, lasamplestep = 0.005; ///< [rad] proposal sampling in yaw

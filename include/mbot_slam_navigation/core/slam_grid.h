@@ -50,11 +50,8 @@ class SlamGrid {
   int height() const { return patches_y_ * kPatchSize; }
 
   // Inline: these two are the scan matcher's inner loop.
-  Cell worldToCell(const Eigen::Vector2d& p) const {
-    return Cell{static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
-                static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
-  }
-  Eigen::Vector2d cellCenter(const Cell& c) const;
+  Cell worldToCell(const Eigen::Vector2d& p) const { return core::worldToCell(origin_, resolution_, p); }
+  Eigen::Vector2d cellCenter(const Cell& c) const { return core::cellCenter(origin_, resolution_, c); }
   /// The cell (a shared empty cell outside the grid or in unwritten patches).
   const HitCell& cell(const Cell& c) const {
     if (c.x < 0 || c.y < 0) return empty_cell_;
