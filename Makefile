@@ -34,7 +34,7 @@ test: build
 	cd $(WS) && catkin_test_results --verbose build/test_results
 
 demo: build
-	cd $(WS) && $(SOURCE) && roslaunch $(PKG) smoke.launch report:=true
+	cd $(WS) && $(SOURCE) && roslaunch $(PKG) slam_demo.launch report_dir:=$(CURDIR)/report
 
 bench: build
 	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/bench/run_all.py

@@ -215,22 +215,29 @@ class SlamGmappingNode {
 
   void publishTransformLoop() {
     ros::Rate rate(1.0 / transform_publish_period_);
+    ros::Time last_tf_time;
     while (ros::ok()) {
       Eigen::Vector3d m;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         m = map_to_odom_;
       }
+      const ros::Time now = ros::Time::now();
+      if (now.isZero() || now == last_tf_time) {  // no /clock yet, or it has not moved: nothing new
+        rate.sleep();
+        continue;
+      }
+      last_tf_time = now;
       geometry_msgs::TransformStamped t;
       // Stamped ahead, as gmapping does, so that lookups at "now" find it.
-      t.header.stamp = ros::Time::now() + ros::Duration(tf_delay_ > 0.0 ? tf_delay_ : transform_publish_period_);
+      t.header.stamp = now + ros::Duration(tf_delay_ > 0.0 ? tf_delay_ : transform_publish_period_);
       t.header.frame_id = map_frame_;
       t.child_frame_id = odom_frame_;
       t.transform.translation.x = m.x();
       t.transform.translation.y = m.y();
       t.transform.rotation.z = std::sin(m.z() / 2.0);
       t.transform.rotation.w = std::cos(m.z() / 2.0);
-      if (!t.header.stamp.isZero()) broadcaster_.sendTransform(t);
+      broadcaster_.sendTransform(t);
       rate.sleep();
     }
   }

@@ -18,14 +18,10 @@ from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.srv import GetMap
 from sensor_msgs.msg import LaserScan
 
+from mbot_slam_navigation.route_driver import LIVING_ROOM_LOOPS, RouteDriver
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, occupied_points
 from mbot_slam_navigation.sim.sdf_world import load_world
 from mbot_slam_navigation.transforms import quaternion_to_yaw
-
-# Around the living room twice (world frame, m): clear of the sofa, coffee table and plant.
-ROUTE = [(-1.0, -1.0), (-2.0, -2.8), (-4.2, -3.2), (-4.6, -1.5), (-3.0, -0.3), (0.0, -0.3), (0.3, -2.5),
-         (-1.0, -3.2), (-2.0, -2.8), (-4.2, -3.2), (-4.6, -1.5), (-3.0, -0.3), (0.0, -0.5)]
-
 
 class SlamHomeTest(unittest.TestCase):
     def test_map_and_pose_follow_the_truth(self):
@@ -41,33 +37,31 @@ class SlamHomeTest(unittest.TestCase):
         errors = []
         rate = rospy.Rate(20)
         last_check = rospy.Time(0)
-        for wx, wy in ROUTE:
-            deadline = rospy.Time.now() + rospy.Duration(60.0)
-            while not rospy.is_shutdown():
-                self.assertLess(rospy.Time.now(), deadline, 'route point (%.1f, %.1f) not reached' % (wx, wy))
-                p, stamp = truth.get('pose'), truth.get('stamp')
-                if p is None:
-                    rate.sleep()
-                    continue
-                x, y = p.position.x, p.position.y
-                yaw = quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
-                dist, bearing = math.hypot(wx - x, wy - y), math.atan2(wy - y, wx - x)
-                if dist < 0.15:
-                    break
-                err = math.atan2(math.sin(bearing - yaw), math.cos(bearing - yaw))
-                t = Twist()
-                t.angular.z = max(-0.8, min(0.8, 2.0 * err))
-                t.linear.x = 0.3 if abs(err) < 0.4 else 0.0
-                cmd.publish(t)
-                if rospy.Time.now() - last_check > rospy.Duration(1.0):
-                    last_check = rospy.Time.now()
-                    try:
-                        # at the ground truth's own time, so that latency does not count as error
-                        tf = tf_buffer.lookup_transform('map', 'base_footprint', stamp, rospy.Duration(0.5))
-                        errors.append(math.hypot(tf.transform.translation.x - x, tf.transform.translation.y - y))
-                    except tf2_ros.TransformException:
-                        pass
+        driver = RouteDriver(LIVING_ROOM_LOOPS)
+        deadline = rospy.Time.now() + rospy.Duration(600.0)
+        while not rospy.is_shutdown() and not driver.done:
+            self.assertLess(rospy.Time.now(), deadline, 'route not done; at waypoint %d' % driver.index)
+            p, stamp = truth.get('pose'), truth.get('stamp')
+            if p is None:
                 rate.sleep()
+                continue
+            x, y = p.position.x, p.position.y
+            yaw = quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
+            c = driver.command((x, y, yaw))
+            if c is None:
+                break
+            t = Twist()
+            t.linear.x, t.angular.z = c
+            cmd.publish(t)
+            if rospy.Time.now() - last_check > rospy.Duration(1.0):
+                last_check = rospy.Time.now()
+                try:
+                    # at the ground truth's own time, so that latency does not count as error
+                    tf = tf_buffer.lookup_transform('map', 'base_footprint', stamp, rospy.Duration(0.5))
+                    errors.append(math.hypot(tf.transform.translation.x - x, tf.transform.translation.y - y))
+                except tf2_ros.TransformException:
+                    pass
+            rate.sleep()
         cmd.publish(Twist())
         rospy.sleep(3.0)  # one more map update after the last scans
         msg = rospy.wait_for_message('/map', OccupancyGrid, timeout=30.0)
