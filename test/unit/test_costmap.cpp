@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -87,4 +88,47 @@ TEST(Footprint, RadiiPaddingAndCollision) {
   EXPECT_EQ(footprintCost(m, {3.25, 2.5, 0.0}, square), 0);
   EXPECT_EQ(footprintCost(m, {3.25, 2.5, M_PI / 4}, square), -1);
   EXPECT_EQ(footprintCost(m, {0.1, 2.5, 0.0}, square), -1);  // partly off the map
+}
+
+#include "mbot_slam_navigation/core/obstacle_layer.h"
+
+namespace {
+LaserScan fan(std::vector<float> ranges, double range_max = 5.0) {
+  LaserScan s;
+  s.angle_min_rad = 0.0;
+  s.angle_increment_rad = M_PI / 2;  // east, north, west, south
+  s.range_min_m = 0.1;
+  s.range_max_m = range_max;
+  s.ranges_m = std::move(ranges);
+  return s;
+}
+}  // namespace
+
+TEST(ObstacleLayer, MarksWithinObstacleRangeAndClearsByRayTracing) {
+  Costmap layer(100, 100, 0.05, {-2.5, -2.5}, cost::kNoInformation);
+  ObservationSourceParams p;  // obstacle_range 2.5, raytrace_range 3.0
+  const float inf = std::numeric_limits<float>::infinity();
+  // A box placed 1 m east, then moved away: the first scan marks it, the second clears it.
+  EXPECT_EQ(updateWithScan(layer, {0, 0, 0}, fan({1.0f, inf, std::nanf(""), 2.6f}), p), 1);
+  const Cell box = layer.worldToCell({1.0, 0.0});
+  EXPECT_EQ(layer.cost(box), cost::kLethal);
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.5, 0.0})), cost::kFree);          // cleared before it
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.0, 2.0})), cost::kFree);          // +inf clears north...
+  EXPECT_EQ(layer.cost(layer.worldToCell({-1.0, 0.0})), cost::kNoInformation);  // NaN beam: nothing
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.0, -1.0})), cost::kFree);         // 2.6 m south: beyond obstacle_range,
+  for (int y = 0; y < 100; ++y) EXPECT_NE(layer.cost({50, y}), y == 50 ? 255 : cost::kLethal);  // cleared, not marked
+  updateWithScan(layer, {0, 0, 0}, fan({2.0f, inf, inf, inf}), p);
+  EXPECT_EQ(layer.cost(box), cost::kFree);
+  EXPECT_EQ(layer.cost(layer.worldToCell({2.0, 0.0})), cost::kLethal);
+}
+
+TEST(ObstacleLayer, ClearingStopsAtRaytraceRange) {
+  Costmap layer(200, 10, 0.05, {-0.5, -0.25}, cost::kLethal);
+  ObservationSourceParams p;
+  p.raytrace_range = 1.0;
+  p.obstacle_range = 0.5;
+  updateWithScan(layer, {0, 0, 0}, fan({4.0f}), p);
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.9, 0.0})), cost::kFree);
+  EXPECT_EQ(layer.cost(layer.worldToCell({1.2, 0.0})), cost::kLethal);  // beyond raytrace_range: kept
+  EXPECT_EQ(layer.cost(layer.worldToCell({4.0, 0.0})), cost::kLethal);  // not marked anew, not cleared
 }

@@ -1,0 +1,34 @@
+// costmap_2d's obstacle layer for laser scans, on one Costmap the layer owns: each scan first
+// clears (ray traces to free) the cells between the sensor and each beam's end, then marks the end
+// points as lethal. Ranges follow REP 117.
+//   - marking: a return closer than obstacle_range marks its end cell lethal;
+//   - clearing: every beam clears up to its end (exclusive) or raytrace_range, whichever is nearer;
+//     +inf (no return within range_max) clears to min(raytrace_range, range_max) when
+//     inf_is_valid, as costmap_2d does for `inf_is_valid: true`;
+//   - NaN, -inf and returns below range_min do nothing.
+// Frames: `sensor_pose` is the laser in the costmap's global frame (x [m], y [m], yaw [rad]).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/laser_scan.h"
+
+namespace mbot {
+namespace core {
+
+struct ObservationSourceParams {
+  double obstacle_range = 2.5;   ///< [m] `obstacle_range` (costmap_2d default 2.5)
+  double raytrace_range = 3.0;   ///< [m] `raytrace_range` (default 3.0)
+  bool marking = true;
+  bool clearing = true;
+  bool inf_is_valid = true;      ///< +inf clears (a simulated or real laser that reports "nothing")
+  void validate() const;         ///< std::invalid_argument naming the parameter
+};
+
+/// Applies one scan to `layer`; returns the number of cells marked.
+int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const LaserScan& scan,
+                   const ObservationSourceParams& params);
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,53 @@
+#include "mbot_slam_navigation/core/obstacle_layer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "mbot_slam_navigation/core/bresenham.h"
+
+namespace mbot {
+namespace core {
+
+void ObservationSourceParams::validate() const {
+  if (!(obstacle_range > 0.0)) throw std::invalid_argument("obstacle_range must be positive");
+  if (!(raytrace_range > 0.0)) throw std::invalid_argument("raytrace_range must be positive");
+}
+
+int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const LaserScan& scan,
+                   const ObservationSourceParams& params) {
+  params.validate();
+  const Eigen::Vector2d origin = sensor_pose.head<2>();
+  const Cell from = layer.worldToCell(origin);
+  std::vector<Cell> marks;
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    double r = scan.ranges_m[i];
+    bool is_return = true;
+    if (std::isnan(r) || r < scan.range_min_m) continue;  // NaN, -inf, too close: nothing known
+    if (std::isinf(r) || r >= scan.range_max_m) {
+      if (!params.inf_is_valid) continue;
+      r = std::min(params.raytrace_range, scan.range_max_m);
+      is_return = false;
+    }
+    const double a = sensor_pose.z() + scan.beamAngle(i);
+    const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+    const Cell end = layer.worldToCell(origin + r * dir);
+    if (params.clearing) {
+      const double clear_r = std::min(r, params.raytrace_range);
+      const Cell clear_end = layer.worldToCell(origin + clear_r * dir);
+      // Clear up to the end point's cell, never the end point itself (it is what the beam hit).
+      walkLine(from, clear_end, [&](const Cell& c) {
+        if (!layer.contains(c)) return false;
+        if (is_return && c == end) return false;
+        layer.setCost(c, cost::kFree);
+        return true;
+      });
+    }
+    if (params.marking && is_return && r < params.obstacle_range && layer.contains(end)) marks.push_back(end);
+  }
+  for (const Cell& c : marks) layer.setCost(c, cost::kLethal);  // after clearing, as costmap_2d
+  return static_cast<int>(marks.size());
+}
+
+}  // namespace core
+}  // namespace mbot
