@@ -328,6 +328,8 @@ class SimNode:
                 last_viewer = time.monotonic()
                 with self.lock:
                     self.viewer.draw(self.sim)
+            if now < sim0:  # reset_simulation took time back: pace from here
+                wall0, sim0 = time.monotonic(), now
             if self.rtf > 0:
                 ahead = (now - sim0) / self.rtf - (time.monotonic() - wall0)
                 if ahead > 0:
