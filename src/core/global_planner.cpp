@@ -40,23 +40,23 @@ Plan GlobalPlanner::makePlan(const Costmap& map, const Eigen::Vector2d& start_m,
   Plan plan;
   const Cell s = map.worldToCell(start_m), g = map.worldToCell(goal_m);
   std::ostringstream why;
-  if (!map.contains(s)) {
-    plan.status = PlanStatus::kStartOffMap;
-    why << "the start (" << start_m.x() << ", " << start_m.y() << ") is off the costmap";
+  auto fail = [&](PlanStatus status) {
+    plan.status = status;
     plan.message = why.str();
+    plan.path.clear();
     return plan;
+  };
+  if (!map.contains(s)) {
+    why << "the start (" << start_m.x() << ", " << start_m.y() << ") is off the costmap";
+    return fail(PlanStatus::kStartOffMap);
   }
   if (!map.contains(g)) {
-    plan.status = PlanStatus::kGoalOffMap;
     why << "the goal (" << goal_m.x() << ", " << goal_m.y() << ") is off the costmap";
-    plan.message = why.str();
-    return plan;
+    return fail(PlanStatus::kGoalOffMap);
   }
   if (map.cost(s) == cost::kLethal) {
-    plan.status = PlanStatus::kStartOccupied;
     why << "the start (" << start_m.x() << ", " << start_m.y() << ") is in a lethal cell";
-    plan.message = why.str();
-    return plan;
+    return fail(PlanStatus::kStartOccupied);
   }
   const std::size_t n = map.costs().size();
   if (value_.size() != n) {
@@ -94,23 +94,18 @@ Plan GlobalPlanner::makePlan(const Costmap& map, const Eigen::Vector2d& start_m,
       }
     }
     if (best < 0) {
-      plan.status = PlanStatus::kGoalOccupied;
       why << "the goal (" << goal_m.x() << ", " << goal_m.y() << ") is in an obstacle or its inflation, and no free cell lies within default_tolerance "
           << params_.default_tolerance << " m";
-      plan.message = why.str();
-      return plan;
+      return fail(PlanStatus::kGoalOccupied);
     }
     goal = best;
   }
   plan.goal = map.cellCenter({goal % map.width(), goal / map.width()});
   const bool found = params_.use_astar ? searchAStar(map, start, goal, plan) : search(map, start, goal, plan);
   if (!found) {
-    plan.status = PlanStatus::kNoPath;
     why << "no path from (" << start_m.x() << ", " << start_m.y() << ") to (" << plan.goal.x() << ", " << plan.goal.y()
         << ") avoids the obstacles" << (params_.allow_unknown ? "" : " through known space (allow_unknown is false)");
-    plan.message = why.str();
-    plan.path.clear();
-    return plan;
+    return fail(PlanStatus::kNoPath);
   }
   plan.status = PlanStatus::kOk;
   return plan;
@@ -172,8 +167,7 @@ bool GlobalPlanner::search(const Costmap& map, int start, int goal, Plan& plan) 
       for (int dx = -1; dx <= 1; ++dx) {
         if ((dx == 0 && dy == 0) || x + dx < 0 || y + dy < 0 || x + dx >= w || y + dy >= h) continue;
         const int k = i + dy * w + dx;
-        // A diagonal step must not cut the corner of an obstacle.
-        if (dx != 0 && dy != 0 && (!std::isfinite(cellCost(i + dx)) || !std::isfinite(cellCost(i + dy * w)))) continue;
+        if (cutsCorner(i, dx, dy, w)) continue;
         if (value(k) < best_p) {
           best_p = value(k);
           best = k;
@@ -218,7 +212,7 @@ bool GlobalPlanner::searchAStar(const Costmap& map, int start, int goal, Plan& p
         if (isDone(k)) continue;
         const float ck = cellCost(k);
         if (!std::isfinite(ck)) continue;
-        if (dx != 0 && dy != 0 && (!std::isfinite(cellCost(i + dx)) || !std::isfinite(cellCost(i + dy * w)))) continue;
+        if (cutsCorner(i, dx, dy, w)) continue;
         const float g = value(i) + ck * (dx != 0 && dy != 0 ? diag : 1.0f);
         if (g < value(k)) {
           if (stamp_[k] != generation_) done_[k] = 0;

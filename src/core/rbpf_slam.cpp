@@ -37,7 +37,7 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, d
   if (!initialized_) {
     // The map frame starts where odometry is at the first scan, so map and odom coincide there.
     for (Particle& p : particles_) p.pose = odom;
-    last_odom_ = last_update_odom_ = odom;
+    last_odom_ = odom;
   } else {
     for (Particle& p : particles_) p.pose = motion_.sample(p.pose, odom, last_odom_, rng_);
     const Eigen::Vector3d step = relativePose(last_odom_, odom);
@@ -62,7 +62,6 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, d
   initialized_ = true;
   linear_distance_ = angular_distance_ = 0.0;
   last_update_time_ = time_s;
-  last_update_odom_ = odom;
   ++updates_;
   return true;
 }

@@ -107,15 +107,6 @@ OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
   return img;
 }
 
-int SlamGrid::knownCount() const {
-  int n = 0;
-  for (const auto& p : patches_) {
-    if (!p) continue;
-    for (const HitCell& c : p->cells) n += c.visits > 0;
-  }
-  return n;
-}
-
 int SlamGrid::ownedPatches() const {
   int n = 0;
   for (const auto& p : patches_) n += p && p.use_count() == 1;

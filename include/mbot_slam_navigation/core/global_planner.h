@@ -13,6 +13,7 @@
 // empty path without a reason.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -59,6 +60,10 @@ class GlobalPlanner {
  private:
   static constexpr float kUnreached = std::numeric_limits<float>::infinity();
   float cellCost(int i) const { return i == start_ ? start_cost_ : cost_of_value_[(*costs_)[i]]; }
+  /// A diagonal step (dx, dy both non-zero) from cell i must not cut the corner of an obstacle.
+  bool cutsCorner(int i, int dx, int dy, int w) const {
+    return dx != 0 && dy != 0 && (!std::isfinite(cellCost(i + dx)) || !std::isfinite(cellCost(i + dy * w)));
+  }
   float value(int i) const { return valueAt(static_cast<std::size_t>(i)); }
   void setValue(int i, float v) {
     stamp_[i] = generation_;

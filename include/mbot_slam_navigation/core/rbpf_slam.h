@@ -99,7 +99,6 @@ class RbpfSlam {
   std::vector<Particle> particles_;
   bool initialized_ = false;
   Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d last_update_odom_ = Eigen::Vector3d::Zero();
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0;
   double last_neff_ = 0.0;
   int updates_ = 0, resamples_ = 0;

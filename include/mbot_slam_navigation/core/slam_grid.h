@@ -72,8 +72,6 @@ class SlamGrid {
 
   /// gmapping's map: a visited cell with hits / visits > occ_thresh is occupied, else free.
   OccupancyImage toOccupancy(double occ_thresh) const;
-  /// Cells visited at least once.
-  int knownCount() const;
   /// Patches allocated by this grid alone (not shared with any other grid) and in all.
   int ownedPatches() const;
   int allocatedPatches() const;
