@@ -9,6 +9,9 @@
 #include "mbot_slam_navigation/core/bresenham.h"
 #include "mbot_slam_navigation/core/diff_drive.h"
 #include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/footprint.h"
+#include "mbot_slam_navigation/core/local_planner.h"
+#include "mbot_slam_navigation/core/obstacle_layer.h"
 #include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
@@ -312,11 +315,55 @@ PYBIND11_MODULE(_core, m) {
              return map;
            }),
            py::arg("costs"), py::arg("resolution"), py::arg("origin"))
+      .def_property_readonly("width", &Costmap::width)
+      .def_property_readonly("height", &Costmap::height)
+      .def_property_readonly("resolution", &Costmap::resolution)
+      .def_property_readonly("origin", [](const Costmap& c) { return Eigen::Vector2d(c.origin()); })
       .def("costs", [](const Costmap& c) {
         py::array_t<uint8_t> out({c.height(), c.width()});
         std::copy(c.costs().begin(), c.costs().end(), out.mutable_data());
         return out;
       })
+      .def("set_costs",
+           [](Costmap& c, const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& costs) {
+             if (costs.ndim() != 2 || costs.shape(0) != c.height() || costs.shape(1) != c.width()) {
+               throw std::invalid_argument("set_costs: the array must be height x width = " + std::to_string(c.height()) +
+                                           " x " + std::to_string(c.width()));
+             }
+             std::copy(costs.data(), costs.data() + costs.size(), c.costs().begin());
+           })
+      .def("move_origin", &Costmap::moveOrigin, py::arg("new_origin"), py::arg("fill"))
+      .def(
+          "update_with_scan",
+          [](Costmap& c, const Eigen::Vector3d& sensor_pose, double angle_min, double angle_increment, double range_min,
+             double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,
+             double obstacle_range, double raytrace_range, bool marking, bool clearing, bool inf_is_valid) {
+            mbot::core::ObservationSourceParams p;
+            p.obstacle_range = obstacle_range;
+            p.raytrace_range = raytrace_range;
+            p.marking = marking;
+            p.clearing = clearing;
+            p.inf_is_valid = inf_is_valid;
+            const LaserScan scan = toScan(angle_min, angle_increment, range_min, range_max, ranges);
+            py::gil_scoped_release release;
+            return mbot::core::updateWithScan(c, sensor_pose, scan, p);
+          },
+          py::arg("sensor_pose"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("range_min"),
+          py::arg("range_max"), py::arg("ranges"), py::arg("obstacle_range"), py::arg("raytrace_range"),
+          py::arg("marking") = true, py::arg("clearing") = true, py::arg("inf_is_valid") = true)
+      .def(
+          "footprint_cost",
+          [](const Costmap& c, const Eigen::Vector3d& pose, const std::vector<Eigen::Vector2d>& footprint,
+             bool unknown_is_obstacle) { return mbot::core::footprintCost(c, pose, footprint, unknown_is_obstacle); },
+          py::arg("pose"), py::arg("footprint"), py::arg("unknown_is_obstacle") = true)
+      .def(
+          "footprint_cells",
+          [](const Costmap& c, const Eigen::Vector3d& pose, const std::vector<Eigen::Vector2d>& footprint) {
+            std::vector<std::pair<int, int>> out;
+            for (const auto& cell : mbot::core::footprintCells(c, pose, footprint)) out.emplace_back(cell.x, cell.y);
+            return out;
+          },
+          py::arg("pose"), py::arg("footprint"))
       .def("occupancy_data", [](const Costmap& c) {
         const auto d = c.toOccupancyData();
         py::array_t<int8_t> out({c.height(), c.width()});
@@ -349,5 +396,83 @@ PYBIND11_MODULE(_core, m) {
             }
             return py::make_tuple(std::string(mbot::core::toString(plan.status)), path, plan.message, plan.expanded);
           },
-          py::arg("costmap"), py::arg("start"), py::arg("goal"));
+          py::arg("costmap"), py::arg("start"), py::arg("goal"))
+      .def(
+          "potential",
+          [](const GlobalPlanner& planner, const Costmap& map) {
+            py::array_t<float> out({map.height(), map.width()});
+            float* d = out.mutable_data();
+            for (std::size_t i = 0; i < map.costs().size(); ++i) d[i] = planner.valueAt(i);
+            return out;
+          },
+          py::arg("costmap"));
+
+  // --- Footprints and the local planner ----------------------------------------------------------
+  m.def("_circle_footprint", &mbot::core::circleFootprint, py::arg("radius"));
+  m.def("_pad_footprint", &mbot::core::padFootprint, py::arg("footprint"), py::arg("padding"));
+  m.def("_inscribed_radius", &mbot::core::inscribedRadius, py::arg("footprint"));
+  m.def("_circumscribed_radius", &mbot::core::circumscribedRadius, py::arg("footprint"));
+  m.def("_validate_footprint", &mbot::core::validateFootprint, py::arg("footprint"));
+
+  using mbot::core::LocalPlannerParams;
+  py::class_<LocalPlannerParams>(m, "_LocalPlannerParams")
+      .def(py::init<>())
+      .def_readwrite("acc_lim_x", &LocalPlannerParams::acc_lim_x)
+      .def_readwrite("acc_lim_y", &LocalPlannerParams::acc_lim_y)
+      .def_readwrite("acc_lim_theta", &LocalPlannerParams::acc_lim_theta)
+      .def_readwrite("max_vel_x", &LocalPlannerParams::max_vel_x)
+      .def_readwrite("min_vel_x", &LocalPlannerParams::min_vel_x)
+      .def_readwrite("max_vel_theta", &LocalPlannerParams::max_vel_theta)
+      .def_readwrite("min_vel_theta", &LocalPlannerParams::min_vel_theta)
+      .def_readwrite("min_in_place_vel_theta", &LocalPlannerParams::min_in_place_vel_theta)
+      .def_readwrite("escape_vel", &LocalPlannerParams::escape_vel)
+      .def_readwrite("sim_time", &LocalPlannerParams::sim_time)
+      .def_readwrite("sim_granularity", &LocalPlannerParams::sim_granularity)
+      .def_readwrite("angular_sim_granularity", &LocalPlannerParams::angular_sim_granularity)
+      .def_readwrite("vx_samples", &LocalPlannerParams::vx_samples)
+      .def_readwrite("vtheta_samples", &LocalPlannerParams::vtheta_samples)
+      .def_readwrite("path_distance_bias", &LocalPlannerParams::path_distance_bias)
+      .def_readwrite("goal_distance_bias", &LocalPlannerParams::goal_distance_bias)
+      .def_readwrite("occdist_scale", &LocalPlannerParams::occdist_scale)
+      .def_readwrite("meter_scoring", &LocalPlannerParams::meter_scoring)
+      .def_readwrite("heading_lookahead", &LocalPlannerParams::heading_lookahead)
+      .def_readwrite("heading_scoring", &LocalPlannerParams::heading_scoring)
+      .def_readwrite("heading_scoring_timestep", &LocalPlannerParams::heading_scoring_timestep)
+      .def_readwrite("oscillation_reset_dist", &LocalPlannerParams::oscillation_reset_dist)
+      .def_readwrite("escape_reset_dist", &LocalPlannerParams::escape_reset_dist)
+      .def_readwrite("escape_reset_theta", &LocalPlannerParams::escape_reset_theta)
+      .def_readwrite("holonomic_robot", &LocalPlannerParams::holonomic_robot)
+      .def_readwrite("dwa", &LocalPlannerParams::dwa)
+      .def_readwrite("simple_attractor", &LocalPlannerParams::simple_attractor)
+      .def_readwrite("y_vels", &LocalPlannerParams::y_vels)
+      .def_readwrite("sim_period", &LocalPlannerParams::sim_period);
+
+  using mbot::core::LocalPlanner;
+  py::class_<LocalPlanner>(m, "_LocalPlanner")
+      .def(py::init<const LocalPlannerParams&, const mbot::core::Footprint&>(), py::arg("params"), py::arg("footprint"))
+      .def("set_plan", &LocalPlanner::setPlan, py::arg("plan"))
+      .def(
+          "find_best_path",
+          [](LocalPlanner& lp, const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity) {
+            mbot::core::Trajectory t;
+            {
+              py::gil_scoped_release release;
+              t = lp.findBestPath(map, pose, velocity);
+            }
+            return py::make_tuple(Eigen::Vector3d(t.xv, t.yv, t.thetav), t.cost, t.points);
+          },
+          py::arg("costmap"), py::arg("pose"), py::arg("velocity"))
+      .def("score_trajectory", &LocalPlanner::scoreTrajectory, py::arg("costmap"), py::arg("pose"), py::arg("velocity"),
+           py::arg("command"))
+      .def("update_grids", &LocalPlanner::updateGrids, py::arg("costmap"), py::arg("pose"))
+      .def("reset_oscillation", &LocalPlanner::resetOscillation)
+      .def_property_readonly("local_goal", [](const LocalPlanner& lp) { return Eigen::Vector2d(lp.localGoal()); })
+      .def_property_readonly("escaping", &LocalPlanner::escaping)
+      .def("path_distances", [](const LocalPlanner& lp, const Costmap& map) {
+        py::array_t<float> out({map.height(), map.width()});
+        const auto& v = lp.pathGrid().values();
+        if (v.size() != map.costs().size()) throw std::invalid_argument("path_distances: no grid for this costmap yet");
+        std::copy(v.begin(), v.end(), out.mutable_data());
+        return out;
+      });
 }

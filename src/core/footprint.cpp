@@ -58,7 +58,9 @@ void validateFootprint(const Footprint& f) {
 
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle) {
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
-  std::vector<Cell> corners;
+  // Reused between calls: the local planner calls this for every step of every trajectory.
+  thread_local std::vector<Cell> corners;
+  corners.clear();
   for (const auto& v : footprint) {
     corners.push_back(map.worldToCell({pose.x() + c * v.x() - s * v.y(), pose.y() + s * v.x() + c * v.y()}));
   }

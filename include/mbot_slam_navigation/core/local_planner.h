@@ -1,0 +1,146 @@
+// base_local_planner's TrajectoryPlanner (trajectory rollout, and DWA when `dwa`), ROS-free.
+//
+// Each control cycle samples velocity commands (vx, vtheta; plus strafes for holonomic robots),
+// forward-simulates each for sim_time under the acceleration limits, and scores the trajectory
+//   cost = path_distance_bias * path_dist + goal_distance_bias * goal_dist + occdist_scale * occ
+// where path_dist / goal_dist are the 4-connected cell distances (MapGrid) from the trajectory's
+// last point to the global plan / to the plan's last point inside the local costmap, and occ is the
+// highest costmap value under the footprint along the trajectory. A trajectory is invalid (-1) if
+// the footprint outline touches a lethal or unknown cell or leaves the map, and (-2) if it enters a
+// cell with no path to the goal. With meter_scoring the two biases are multiplied by the costmap
+// resolution, so the distances count in metres.
+// When no forward trajectory is valid it rotates in place towards the goal (with min_in_place
+// speed), then strafes (holonomic), then backs up at escape_vel, with ROS's oscillation flags
+// (no turning back the way it just turned until it moved oscillation_reset_dist) and escape mode.
+//
+// Frames: every pose is in the local costmap's global frame (x [m], y [m], yaw [rad]); velocities
+// are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/footprint.h"
+
+namespace mbot {
+namespace core {
+
+/// Parameter names, and defaults, of TrajectoryPlannerROS as it behaves in ROS: the
+/// dynamic_reconfigure defaults (BaseLocalPlanner.cfg), which override the constructor's.
+struct LocalPlannerParams {
+  double acc_lim_x = 2.5, acc_lim_y = 2.5, acc_lim_theta = 3.2;  ///< [m/s^2], [rad/s^2]
+  double max_vel_x = 0.55, min_vel_x = 0.0;                       ///< [m/s]
+  double max_vel_theta = 1.0, min_vel_theta = -1.0;               ///< [rad/s]
+  double min_in_place_vel_theta = 0.4;                            ///< [rad/s]
+  double escape_vel = -0.1;                                       ///< [m/s] backing-up speed
+  double sim_time = 1.7;                                          ///< [s]
+  double sim_granularity = 0.025;                                 ///< [m] step along a trajectory
+  double angular_sim_granularity = 0.025;                         ///< [rad]
+  int vx_samples = 20, vtheta_samples = 20;
+  double path_distance_bias = 0.6, goal_distance_bias = 0.8, occdist_scale = 0.01;
+  bool meter_scoring = false;
+  double heading_lookahead = 0.325;                               ///< [m]
+  bool heading_scoring = false;
+  double heading_scoring_timestep = 0.1;                          ///< [s]
+  double oscillation_reset_dist = 0.05, escape_reset_dist = 0.10; ///< [m]
+  double escape_reset_theta = 1.5707963267948966;                 ///< [rad]
+  bool holonomic_robot = true;
+  bool dwa = false;
+  bool simple_attractor = false;
+  std::vector<double> y_vels = {-0.3, -0.1, 0.1, -0.3};           ///< [m/s] (ROS's default string)
+  double sim_period = 0.05;  ///< [s] 1 / controller_frequency: the DWA velocity window
+  /// std::invalid_argument naming the parameter for values ROS would misbehave on.
+  void validate() const;
+};
+
+struct Trajectory {
+  double xv = 0.0, yv = 0.0, thetav = 0.0;  ///< the sampled command
+  double cost = -1.0;                       ///< < 0: invalid (-1 collision, -2 no path to goal)
+  std::vector<Eigen::Vector3d> points;      ///< simulated poses (x, y, yaw)
+};
+
+/// MapGrid: 4-connected cell distances over a costmap to a set of target cells (0 on a target,
+/// +1 per step), through cells that are not lethal, inscribed or unknown (except cells under the
+/// robot). Unreached cells hold unreachable() = cells + 1, obstacle cells obstacle() = cells.
+class DistanceGrid {
+ public:
+  void reset(const Costmap& map);
+  /// Targets the plan's cells from its first point inside the map until it leaves it; returns
+  /// false (and targets nothing) when no plan point is inside the map and known.
+  bool setPath(const Costmap& map, const std::vector<Eigen::Vector2d>& plan);
+  /// Targets the last plan point of the first stretch inside the map (the local goal).
+  bool setLocalGoal(const Costmap& map, const std::vector<Eigen::Vector2d>& plan, Eigen::Vector2d* local_goal = nullptr);
+  void markWithinRobot(const std::vector<Cell>& cells);
+  double at(const Cell& c) const { return dist_[static_cast<std::size_t>(c.y) * width_ + c.x]; }
+  double obstacle() const { return static_cast<double>(dist_.size()); }
+  double unreachable() const { return static_cast<double>(dist_.size()) + 1.0; }
+  const std::vector<float>& values() const { return dist_; }
+
+ private:
+  void propagate(const Costmap& map, std::vector<int>& queue);
+  int width_ = 0;
+  std::vector<float> dist_;
+  std::vector<uint8_t> within_robot_;
+  std::vector<uint8_t> target_;
+};
+
+/// The plan with points inserted so consecutive points are at most `resolution` apart (ROS's
+/// adjustPlanResolution), so every cell it crosses becomes a target.
+std::vector<Eigen::Vector2d> densifyPlan(const std::vector<Eigen::Vector2d>& plan, double resolution);
+
+/// The cells covered by the footprint at `pose`: its outline and interior (costmap frame).
+std::vector<Cell> footprintCells(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint);
+
+class LocalPlanner {
+ public:
+  LocalPlanner(const LocalPlannerParams& params, const Footprint& footprint);
+  const LocalPlannerParams& params() const { return params_; }
+  const Footprint& footprint() const { return footprint_; }
+
+  /// The global plan (costmap frame, pruned to start near the robot).
+  void setPlan(const std::vector<Eigen::Vector2d>& plan);
+  /// One control cycle: the best trajectory from `pose` moving at `velocity`; cost < 0 when none
+  /// is valid (the command is then zero).
+  Trajectory findBestPath(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity);
+  /// The cost of one command from `pose` (ROS's scoreTrajectory; uses the grids of the last
+  /// findBestPath / updateGrids); >= 0 means the command is safe.
+  double scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
+                         const Eigen::Vector3d& command);
+  /// Recomputes the path and goal distance grids for `pose` without choosing a command.
+  void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
+  /// Clears the oscillation and escape state (a new goal).
+  void resetOscillation();
+
+  const DistanceGrid& pathGrid() const { return path_grid_; }
+  const DistanceGrid& goalGrid() const { return goal_grid_; }
+  const Eigen::Vector2d& localGoal() const { return local_goal_; }
+  bool escaping() const { return escaping_; }
+
+ private:
+  void generate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel, double vx_samp,
+                double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj) const;
+  double headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const;
+  Trajectory createTrajectories(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel);
+  void updateOscillationFlags(const Eigen::Vector3d& pose, const Trajectory& best);
+  void resetFlagsIfMoved(const Eigen::Vector3d& pose);
+
+  LocalPlannerParams params_;
+  Footprint footprint_;
+  double path_bias_, goal_bias_;  // scaled by the resolution with meter_scoring (set per cycle)
+  std::vector<Eigen::Vector2d> plan_;
+  bool goal_valid_ = false;
+  Eigen::Vector2d final_goal_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d local_goal_ = Eigen::Vector2d::Zero();
+  DistanceGrid path_grid_, goal_grid_;
+  // ROS's oscillation suppression and escape state.
+  bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
+  bool rotating_left_ = false, rotating_right_ = false, strafe_left_ = false, strafe_right_ = false;
+  bool escaping_ = false;
+  Eigen::Vector2d prev_ = Eigen::Vector2d::Zero(), escape_ = Eigen::Vector2d::Zero();
+  double escape_theta_ = 0.0;
+};
+
+}  // namespace core
+}  // namespace mbot

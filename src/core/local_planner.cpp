@@ -1,0 +1,431 @@
+#include "mbot_slam_navigation/core/local_planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "mbot_slam_navigation/core/bresenham.h"
+#include "mbot_slam_navigation/core/pose2d.h"
+
+namespace mbot {
+namespace core {
+namespace {
+
+bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
+
+/// ROS's computeNewVelocity: move towards the sampled speed by at most a * dt.
+double approach(double target, double current, double acc, double dt) {
+  return target >= current ? std::min(target, current + acc * dt) : std::max(target, current - acc * dt);
+}
+
+}  // namespace
+
+void LocalPlannerParams::validate() const {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0.0)) throw std::invalid_argument(std::string(name) + " must be positive, got " + std::to_string(v));
+  };
+  positive(sim_time, "sim_time");
+  positive(sim_granularity, "sim_granularity");
+  positive(angular_sim_granularity, "angular_sim_granularity");
+  positive(sim_period, "sim_period (1 / controller_frequency)");
+  if (acc_lim_x < 0 || acc_lim_y < 0 || acc_lim_theta < 0) throw std::invalid_argument("acc_lim_x/y/theta must be >= 0");
+  if (min_vel_x > max_vel_x) throw std::invalid_argument("min_vel_x must not exceed max_vel_x");
+  if (min_vel_theta > max_vel_theta) throw std::invalid_argument("min_vel_theta must not exceed max_vel_theta");
+  if (vx_samples < 1 || vtheta_samples < 1) throw std::invalid_argument("vx_samples and vtheta_samples must be >= 1");
+}
+
+// --- DistanceGrid (MapGrid) ----------------------------------------------------------------------
+
+void DistanceGrid::reset(const Costmap& map) {
+  width_ = map.width();
+  const std::size_t n = map.costs().size();
+  dist_.assign(n, static_cast<float>(n + 1));
+  within_robot_.assign(n, 0);
+  target_.assign(n, 0);
+}
+
+void DistanceGrid::markWithinRobot(const std::vector<Cell>& cells) {
+  for (const Cell& c : cells) within_robot_[static_cast<std::size_t>(c.y) * width_ + c.x] = 1;
+}
+
+bool DistanceGrid::setPath(const Costmap& map, const std::vector<Eigen::Vector2d>& plan) {
+  std::vector<int> queue;
+  bool started = false;
+  for (const Eigen::Vector2d& p : densifyPlan(plan, map.resolution())) {
+    const Cell c = map.worldToCell(p);
+    if (map.contains(c) && map.cost(c) != cost::kNoInformation) {
+      const int i = static_cast<int>(map.index(c));
+      if (!target_[i]) {
+        target_[i] = 1;
+        dist_[i] = 0.0f;
+        queue.push_back(i);
+      }
+      started = true;
+    } else if (started) {
+      break;
+    }
+  }
+  if (!started) return false;
+  propagate(map, queue);
+  return true;
+}
+
+bool DistanceGrid::setLocalGoal(const Costmap& map, const std::vector<Eigen::Vector2d>& plan, Eigen::Vector2d* local_goal) {
+  int goal = -1;
+  bool started = false;
+  for (const Eigen::Vector2d& p : densifyPlan(plan, map.resolution())) {
+    const Cell c = map.worldToCell(p);
+    if (map.contains(c) && map.cost(c) != cost::kNoInformation) {
+      goal = static_cast<int>(map.index(c));
+      if (local_goal) *local_goal = p;
+      started = true;
+    } else if (started) {
+      break;
+    }
+  }
+  if (goal < 0) return false;
+  target_[goal] = 1;
+  dist_[goal] = 0.0f;
+  std::vector<int> queue{goal};
+  propagate(map, queue);
+  return true;
+}
+
+void DistanceGrid::propagate(const Costmap& map, std::vector<int>& queue) {
+  // Breadth first from all targets at once: every step costs 1, so FIFO order is distance order.
+  const int w = map.width(), h = map.height();
+  const std::vector<uint8_t>& costs = map.costs();
+  const float obstacle_cost = static_cast<float>(dist_.size());
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int i = queue[head];
+    const int x = i % w, y = i / w;
+    const int nb[4] = {x > 0 ? i - 1 : -1, x < w - 1 ? i + 1 : -1, y > 0 ? i - w : -1, y < h - 1 ? i + w : -1};
+    for (int k : nb) {
+      if (k < 0 || target_[k]) continue;
+      if (!within_robot_[k] && isObstacleValue(costs[k])) {
+        dist_[k] = obstacle_cost;
+        target_[k] = 1;
+        continue;
+      }
+      const float d = dist_[i] + 1.0f;
+      if (d < dist_[k]) dist_[k] = d;
+      target_[k] = 1;
+      queue.push_back(k);
+    }
+  }
+}
+
+std::vector<Eigen::Vector2d> densifyPlan(const std::vector<Eigen::Vector2d>& plan, double resolution) {
+  std::vector<Eigen::Vector2d> out;
+  if (plan.empty()) return out;
+  out.push_back(plan.front());
+  for (std::size_t i = 1; i < plan.size(); ++i) {
+    const Eigen::Vector2d a = out.back(), b = plan[i];
+    const double d = (b - a).norm();
+    const int extra = static_cast<int>(d / resolution);
+    for (int k = 1; k <= extra; ++k) out.push_back(a + (b - a) * (k * resolution / d));
+    out.push_back(b);
+  }
+  return out;
+}
+
+std::vector<Cell> footprintCells(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint) {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  std::vector<Eigen::Vector2d> world;
+  for (const auto& v : footprint) world.emplace_back(pose.x() + c * v.x() - s * v.y(), pose.y() + s * v.x() + c * v.y());
+  std::vector<Cell> cells;
+  std::vector<uint8_t> seen;
+  Cell lo{map.width(), map.height()}, hi{-1, -1};
+  for (const auto& p : world) {
+    const Cell cell = map.worldToCell(p);
+    lo = {std::min(lo.x, cell.x), std::min(lo.y, cell.y)};
+    hi = {std::max(hi.x, cell.x), std::max(hi.y, cell.y)};
+  }
+  lo = {std::max(lo.x, 0), std::max(lo.y, 0)};
+  hi = {std::min(hi.x, map.width() - 1), std::min(hi.y, map.height() - 1)};
+  if (hi.x < lo.x || hi.y < lo.y) return cells;
+  const int bw = hi.x - lo.x + 1;
+  seen.assign(static_cast<std::size_t>(bw) * (hi.y - lo.y + 1), 0);
+  auto add = [&](const Cell& cell) {
+    if (cell.x < lo.x || cell.y < lo.y || cell.x > hi.x || cell.y > hi.y) return;
+    uint8_t& f = seen[static_cast<std::size_t>(cell.y - lo.y) * bw + (cell.x - lo.x)];
+    if (!f) {
+      f = 1;
+      cells.push_back(cell);
+    }
+  };
+  for (std::size_t i = 0, j = world.size() - 1; i < world.size(); j = i++) {
+    walkLine(map.worldToCell(world[j]), map.worldToCell(world[i]), [&](const Cell& cell) {
+      add(cell);
+      return true;
+    });
+  }
+  // Interior: cell centres inside the polygon (even-odd rule).
+  for (int y = lo.y; y <= hi.y; ++y) {
+    for (int x = lo.x; x <= hi.x; ++x) {
+      const Eigen::Vector2d q = map.cellCenter({x, y});
+      bool inside = false;
+      for (std::size_t i = 0, j = world.size() - 1; i < world.size(); j = i++) {
+        const auto &a = world[i], &b = world[j];
+        if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
+      }
+      if (inside) add({x, y});
+    }
+  }
+  return cells;
+}
+
+// --- LocalPlanner --------------------------------------------------------------------------------
+
+LocalPlanner::LocalPlanner(const LocalPlannerParams& params, const Footprint& footprint)
+    : params_(params), footprint_(footprint), path_bias_(params.path_distance_bias), goal_bias_(params.goal_distance_bias) {
+  params_.validate();
+  validateFootprint(footprint_);
+}
+
+void LocalPlanner::setPlan(const std::vector<Eigen::Vector2d>& plan) {
+  plan_ = plan;
+  goal_valid_ = !plan_.empty();
+  if (goal_valid_) final_goal_ = plan_.back();
+}
+
+void LocalPlanner::resetOscillation() {
+  stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
+  rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
+  escaping_ = false;
+}
+
+void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) {
+  path_bias_ = params_.path_distance_bias * (params_.meter_scoring ? map.resolution() : 1.0);
+  goal_bias_ = params_.goal_distance_bias * (params_.meter_scoring ? map.resolution() : 1.0);
+  path_grid_.reset(map);
+  goal_grid_.reset(map);
+  const std::vector<Cell> robot = footprintCells(map, pose, footprint_);
+  path_grid_.markWithinRobot(robot);
+  goal_grid_.markWithinRobot(robot);  // ROS marks only the path map; the goal map needs it as much
+  path_grid_.setPath(map, plan_);
+  goal_grid_.setLocalGoal(map, plan_, &local_goal_);
+}
+
+double LocalPlanner::headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const {
+  // The farthest plan point in line of sight (no lethal/inscribed/unknown cell in between).
+  for (int i = static_cast<int>(plan_.size()) - 1; i >= 0; --i) {
+    const Cell g = map.worldToCell(plan_[i]);
+    if (!map.contains(g)) continue;
+    const bool clear = walkLine(cell, g, [&](const Cell& c) { return !isObstacleValue(map.cost(c)); });
+    if (clear) {
+      const Eigen::Vector2d gc = map.cellCenter(g);
+      return std::abs(normalizeAngle(std::atan2(gc.y() - pose.y(), gc.x() - pose.x()) - pose.z()));
+    }
+  }
+  return std::numeric_limits<double>::max();
+}
+
+void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel, double vx_samp,
+                            double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj) const {
+  const LocalPlannerParams& p = params_;
+  const double vmag = std::hypot(vx_samp, vy_samp);
+  int steps = p.heading_scoring ? static_cast<int>(p.sim_time / p.sim_granularity + 0.5)
+                                : static_cast<int>(std::max(vmag * p.sim_time / p.sim_granularity,
+                                                            std::abs(vth_samp) / p.angular_sim_granularity) + 0.5);
+  steps = std::max(steps, 1);
+  const double dt = p.sim_time / steps;
+  traj.xv = vx_samp;
+  traj.yv = vy_samp;
+  traj.thetav = vth_samp;
+  traj.cost = -1.0;
+  traj.points.clear();
+  double x = pose.x(), y = pose.y(), th = pose.z();
+  double vx = vel.x(), vy = vel.y(), vth = vel.z();
+  double path_dist = 0.0, goal_dist = 0.0, occ = 0.0, heading = 0.0, time = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    const Cell cell = map.worldToCell({x, y});
+    if (!map.contains(cell)) return;  // off the local map
+    const int fp = footprintCost(map, {x, y, th}, footprint_, /*unknown_is_obstacle=*/true);
+    if (fp < 0) return;
+    occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
+    if (p.simple_attractor) {
+      goal_dist = (Eigen::Vector2d(x, y) - final_goal_).squaredNorm();
+    } else {
+      bool update = true;
+      if (p.heading_scoring) {
+        if (time >= p.heading_scoring_timestep && time < p.heading_scoring_timestep + dt) heading = headingDiff(map, cell, {x, y, th});
+        else update = false;
+      }
+      if (update) {
+        path_dist = path_grid_.at(cell);
+        goal_dist = goal_grid_.at(cell);
+        if (impossible_cost <= goal_dist || impossible_cost <= path_dist) {
+          traj.cost = -2.0;
+          return;
+        }
+      }
+    }
+    traj.points.emplace_back(x, y, th);
+    vx = approach(vx_samp, vx, p.acc_lim_x, dt);
+    vy = approach(vy_samp, vy, p.acc_lim_y, dt);
+    vth = approach(vth_samp, vth, p.acc_lim_theta, dt);
+    x += (vx * std::cos(th) - vy * std::sin(th)) * dt;
+    y += (vx * std::sin(th) + vy * std::cos(th)) * dt;
+    th += vth * dt;
+    time += dt;
+  }
+  traj.cost = path_bias_ * path_dist + goal_bias_ * goal_dist + p.occdist_scale * occ + (p.heading_scoring ? 0.3 * heading : 0.0);
+}
+
+double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
+                                     const Eigen::Vector3d& command) {
+  if (path_grid_.values().size() != map.costs().size()) updateGrids(map, pose);
+  Trajectory t;
+  generate(map, pose, velocity, command.x(), command.y(), command.z(), path_grid_.obstacle(), t);
+  return t.cost;
+}
+
+Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity) {
+  updateGrids(map, pose);
+  Trajectory best = createTrajectories(map, pose, velocity);
+  if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;
+  return best;
+}
+
+void LocalPlanner::resetFlagsIfMoved(const Eigen::Vector3d& pose) {
+  if ((pose.head<2>() - prev_).norm() > params_.oscillation_reset_dist) {
+    rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
+    stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
+  }
+  if ((pose.head<2>() - escape_).norm() > params_.escape_reset_dist ||
+      std::abs(normalizeAngle(pose.z() - escape_theta_)) > params_.escape_reset_theta) {
+    escaping_ = false;
+  }
+}
+
+void LocalPlanner::updateOscillationFlags(const Eigen::Vector3d& pose, const Trajectory& best) {
+  // Not moving forward: remember which way it turned or strafed; turning the same way twice
+  // without moving oscillation_reset_dist marks that side stuck, so it cannot flip back and forth.
+  if (!(best.xv > 0)) {
+    if (best.thetav < 0) {
+      if (rotating_right_) stuck_right_ = true;
+      rotating_right_ = true;
+    } else if (best.thetav > 0) {
+      if (rotating_left_) stuck_left_ = true;
+      rotating_left_ = true;
+    } else if (best.yv > 0) {
+      if (strafe_right_) stuck_right_strafe_ = true;
+      strafe_right_ = true;
+    } else if (best.yv < 0) {
+      if (strafe_left_) stuck_left_strafe_ = true;
+      strafe_left_ = true;
+    }
+    prev_ = pose.head<2>();
+  }
+  resetFlagsIfMoved(pose);
+}
+
+Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel) {
+  const LocalPlannerParams& p = params_;
+  double max_vx = p.max_vel_x;
+  if (goal_valid_) max_vx = std::min(max_vx, (final_goal_ - pose.head<2>()).norm() / p.sim_time);
+  // The reachable window: one control period for DWA, the whole simulation for trajectory rollout.
+  const double window = p.dwa ? p.sim_period : p.sim_time;
+  max_vx = std::max(std::min(max_vx, vel.x() + p.acc_lim_x * window), p.min_vel_x);
+  const double min_vx = std::max(p.min_vel_x, vel.x() - p.acc_lim_x * window);
+  const double max_vth = std::min(p.max_vel_theta, vel.z() + p.acc_lim_theta * window);
+  const double min_vth = std::max(p.min_vel_theta, vel.z() - p.acc_lim_theta * window);
+  const double dvx = p.vx_samples > 1 ? (max_vx - min_vx) / (p.vx_samples - 1) : 0.0;
+  const double dvth = p.vtheta_samples > 1 ? (max_vth - min_vth) / (p.vtheta_samples - 1) : 0.0;
+  const double impossible = path_grid_.obstacle();
+
+  Trajectory best, comp;
+  best.cost = -1.0;
+  auto better = [&](const Trajectory& t) { return t.cost >= 0 && (t.cost < best.cost || best.cost < 0); };
+
+  if (!escaping_) {
+    double vx_samp = min_vx;
+    for (int i = 0; i < p.vx_samples; ++i) {
+      generate(map, pose, vel, vx_samp, 0.0, 0.0, impossible, comp);  // straight ahead, always tried
+      if (better(comp)) std::swap(best, comp);
+      double vth_samp = min_vth;
+      for (int j = 0; j < p.vtheta_samples - 1; ++j) {
+        generate(map, pose, vel, vx_samp, 0.0, vth_samp, impossible, comp);
+        if (better(comp)) std::swap(best, comp);
+        vth_samp += dvth;
+      }
+      vx_samp += dvx;
+    }
+    if (p.holonomic_robot) {
+      for (double vy : {0.1, -0.1}) {
+        generate(map, pose, vel, 0.1, vy, 0.0, impossible, comp);
+        if (better(comp)) std::swap(best, comp);
+      }
+    }
+  }
+
+  // Rotating in place, towards where the goal distance a heading_lookahead ahead is smallest.
+  double heading_dist = std::numeric_limits<double>::max();
+  double vth_samp = min_vth;
+  for (int i = 0; i < p.vtheta_samples; ++i) {
+    const double limited = vth_samp > 0 ? std::max(vth_samp, p.min_in_place_vel_theta) : std::min(vth_samp, -p.min_in_place_vel_theta);
+    generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp);
+    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth && !comp.points.empty()) {
+      const Eigen::Vector3d& e = comp.points.back();
+      const Cell ahead = map.worldToCell({e.x() + p.heading_lookahead * std::cos(e.z()), e.y() + p.heading_lookahead * std::sin(e.z())});
+      if (map.contains(ahead)) {
+        const double d = goal_grid_.at(ahead);
+        if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
+          std::swap(best, comp);
+          heading_dist = d;
+        }
+      }
+    }
+    vth_samp += dvth;
+  }
+  if (best.cost >= 0) {
+    updateOscillationFlags(pose, best);
+    return best;
+  }
+
+  if (p.holonomic_robot) {
+    for (double vy : p.y_vels) {
+      generate(map, pose, vel, 0.0, vy, 0.0, impossible, comp);
+      if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0) && !comp.points.empty()) {
+        const Eigen::Vector3d& e = comp.points.back();
+        const Cell ahead = map.worldToCell({e.x() + p.heading_lookahead * std::cos(e.z()), e.y() + p.heading_lookahead * std::sin(e.z())});
+        if (map.contains(ahead)) {
+          const double d = goal_grid_.at(ahead);
+          if (d < heading_dist && ((vy > 0 && !stuck_left_strafe_) || (vy < 0 && !stuck_right_strafe_))) {
+            std::swap(best, comp);
+            heading_dist = d;
+          }
+        }
+      }
+    }
+    if (best.cost >= 0) {
+      // ROS swaps left and right in this branch; the first branch's bookkeeping is the intended one.
+      updateOscillationFlags(pose, best);
+      return best;
+    }
+  }
+
+  // Nothing forward, no turn, no strafe: back up at escape_vel. ROS backs up even when that
+  // collides; here backing up must itself be collision-free, though it may leave the cells that
+  // have a path distance (that is how a robot gets out of an inscribed pocket).
+  generate(map, pose, vel, p.escape_vel, 0.0, 0.0, std::numeric_limits<double>::infinity(), comp);
+  resetFlagsIfMoved(pose);
+  if (comp.cost < 0) {
+    best.cost = -1.0;  // boxed in: no safe command at all
+    return best;
+  }
+  if (!escaping_) {
+    escape_ = pose.head<2>();
+    escape_theta_ = pose.z();
+    escaping_ = true;
+  }
+  resetFlagsIfMoved(pose);
+  comp.cost = std::max(comp.cost, 1.0);
+  return comp;
+}
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,192 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mbot_slam_navigation/core/inflation_layer.h"
+#include "mbot_slam_navigation/core/local_planner.h"
+
+using namespace mbot::core;
+
+namespace {
+// The four-wheel car's footprint from the tutorial's costmap_common_params.yaml.
+Footprint square() { return {{-0.2, -0.2}, {-0.2, 0.2}, {0.2, 0.2}, {0.2, -0.2}}; }
+
+// The tutorial's base_local_planner_params.yaml where it differs from the defaults.
+LocalPlannerParams tutorialParams() {
+  LocalPlannerParams p;
+  p.max_vel_x = 0.3;
+  p.min_vel_x = 0.05;
+  p.min_in_place_vel_theta = 0.5;
+  p.escape_vel = -0.1;
+  p.max_vel_theta = 1.0;
+  p.min_vel_theta = -1.0;
+  p.path_distance_bias = 0.8;
+  p.goal_distance_bias = 0.4;
+  p.holonomic_robot = false;
+  p.meter_scoring = true;
+  return p;
+}
+
+std::vector<Eigen::Vector2d> straightPlan(Eigen::Vector2d from, Eigen::Vector2d to, double step = 0.05) {
+  std::vector<Eigen::Vector2d> plan;
+  const double d = (to - from).norm();
+  for (double s = 0; s <= d + 1e-9; s += step) plan.push_back(from + (to - from) * (s / d));
+  return plan;
+}
+
+Costmap inflated(Costmap m) {
+  InflationParams ip;
+  ip.inscribed_radius = 0.2;
+  ip.inflation_radius = 0.6;
+  inflate(m, ip);
+  return m;
+}
+}  // namespace
+
+TEST(DistanceGrid, CountsFourConnectedStepsAroundObstacles) {
+  Costmap m(10, 10, 1.0, {0, 0});
+  for (int y = 0; y < 9; ++y) m.setCost({5, y}, cost::kLethal);
+  DistanceGrid g;
+  g.reset(m);
+  ASSERT_TRUE(g.setLocalGoal(m, {{8.5, 0.5}}));
+  EXPECT_EQ(g.at({8, 0}), 0.0);
+  EXPECT_EQ(g.at({8, 3}), 3.0);
+  // From (4, 0) the only way is over the wall's end at y = 9: 9 up, 4 across, 9 down.
+  EXPECT_EQ(g.at({4, 0}), 9.0 + 4.0 + 9.0);
+  EXPECT_EQ(g.at({5, 0}), g.obstacle());
+}
+
+TEST(DistanceGrid, UnknownPlanPointsAreNoTarget) {
+  Costmap m(10, 10, 1.0, {0, 0}, cost::kNoInformation);
+  DistanceGrid g;
+  g.reset(m);
+  EXPECT_FALSE(g.setPath(m, {{1.5, 1.5}, {2.5, 1.5}}));
+}
+
+TEST(Densify, InsertsPointsAtMostOneResolutionApart) {
+  const auto d = densifyPlan({{0, 0}, {1, 0}}, 0.1);
+  ASSERT_GE(d.size(), 11u);
+  for (std::size_t i = 1; i < d.size(); ++i) EXPECT_LE((d[i] - d[i - 1]).norm(), 0.1 + 1e-9);
+}
+
+TEST(FootprintCells, CoverTheInteriorOfTheSquare) {
+  Costmap m(40, 40, 0.05, {0, 0});
+  const auto cells = footprintCells(m, {1.0, 1.0, 0.0}, square());
+  // 0.4 m square: 8 x 8 cells plus the outline cells on the far edges (9 x 9 at most).
+  EXPECT_GE(cells.size(), 64u);
+  EXPECT_LE(cells.size(), 81u);
+}
+
+TEST(LocalPlanner, DrivesStraightAlongAStraightPlanAtTheSpeedLimit) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({1.0, 2.5}, {4.5, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {1.0, 2.5, 0.0}, {0.3, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  // ROS scores a trajectory at its last simulated point, one step short of its end, so neighbouring
+  // speeds tie or swap by a cell; the choice is near the top speed, straight ahead.
+  EXPECT_GT(t.xv, 0.8 * 0.3);
+  EXPECT_NEAR(t.thetav, 0.0, 1e-9);
+}
+
+TEST(LocalPlanner, TurnsTowardsAPlanToTheLeft) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.5, 2.5}, {2.5, 4.5}));  // the plan leaves to +y, the robot faces +x
+  const Trajectory t = lp.findBestPath(m, {2.5, 2.5, 0.0}, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_GT(t.thetav, 0.0);
+}
+
+TEST(LocalPlanner, SlowsDownNearTheGoal) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.0, 2.5}, {2.2, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {2.0, 2.5, 0.0}, {0.3, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  // max_vel_x is capped at distance / sim_time = 0.2 / 1.7.
+  EXPECT_LE(t.xv, 0.2 / 1.7 + 1e-9);
+}
+
+TEST(LocalPlanner, NeverChoosesATrajectoryWhoseFootprintHitsAWall) {
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int y = 0; y < 100; ++y) raw.setCost({60, y}, cost::kLethal);  // a wall at x = 3.0 m
+  const Costmap m = inflated(raw);
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.5, 2.5}, {4.5, 2.5}));  // a (bad) plan straight through the wall
+  const Trajectory t = lp.findBestPath(m, {2.6, 2.5, 0.0}, {0.0, 0, 0});
+  for (const auto& p : t.points) EXPECT_GE(footprintCost(m, p, square()), 0) << p.transpose();
+  if (t.cost >= 0 && !t.points.empty()) EXPECT_LT(t.points.back().x() + 0.2, 3.0);
+}
+
+TEST(LocalPlanner, ACentreInAnInscribedCellCanStillTurnOrBackOut) {
+  // A lethal cell 0.1 m ahead of the centre, inside the body (a thin obstacle seen under the robot):
+  // the centre cell is inscribed, but the footprint's outline is clear, so the robot is not frozen.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  raw.setCost(raw.worldToCell({2.62, 2.52}), cost::kLethal);
+  const Costmap m = inflated(raw);
+  const Eigen::Vector3d pose(2.52, 2.52, 0.0);
+  ASSERT_EQ(m.cost(m.worldToCell(pose.head<2>())), cost::kInscribed);
+  ASSERT_GE(footprintCost(m, pose, square()), 0);
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.52, 2.52}, {2.52, 0.5}));  // the way on is to the right
+  const Trajectory t = lp.findBestPath(m, pose, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_TRUE(t.xv != 0.0 || t.thetav != 0.0);
+}
+
+TEST(LocalPlanner, BoxedInGivesNoCommand) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  // A 0.5 m box of lethal cells around a 0.4 m robot: no turn, no back-up, no forward move.
+  for (int i = 40; i <= 60; ++i) {
+    m.setCost({i, 40}, cost::kLethal);
+    m.setCost({i, 50}, cost::kLethal);
+    m.setCost({40, i}, cost::kLethal);
+  }
+  for (int i = 40; i <= 50; ++i) m.setCost({45, i}, cost::kLethal);
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.5, 2.25}, {4.5, 2.25}));
+  const Trajectory t = lp.findBestPath(m, {2.5, 2.25, 0.0}, {0, 0, 0});
+  EXPECT_LT(t.cost, 0.0);
+  EXPECT_EQ(t.xv, 0.0);
+  EXPECT_EQ(t.thetav, 0.0);
+}
+
+TEST(LocalPlanner, DwaLimitsTheWindowToOneControlPeriod) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlannerParams p = tutorialParams();
+  p.dwa = true;
+  p.sim_period = 0.1;
+  p.acc_lim_x = 0.5;  // from rest, one period allows at most 0.05 m/s more
+  LocalPlanner lp(p, square());
+  lp.setPlan(straightPlan({1.0, 2.5}, {4.5, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {1.0, 2.5, 0.0}, {0.0, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_LE(t.xv, 0.05 + 1e-9);
+  p.dwa = false;  // trajectory rollout: the window is sim_time long, 0.5 * 1.7 > max_vel_x
+  LocalPlanner rollout(p, square());
+  rollout.setPlan(straightPlan({1.0, 2.5}, {4.5, 2.5}));
+  EXPECT_NEAR(rollout.findBestPath(m, {1.0, 2.5, 0.0}, {0.0, 0, 0}).xv, 0.3, 1e-9);
+}
+
+TEST(LocalPlanner, ScoresWorseFartherFromThePath) {
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({1.0, 2.5}, {4.5, 2.5}));
+  lp.updateGrids(m, {1.0, 2.5, 0.0});
+  const double on = lp.scoreTrajectory(m, {1.0, 2.5, 0.0}, {0.3, 0, 0}, {0.3, 0, 0});
+  const double off = lp.scoreTrajectory(m, {1.0, 2.5, 0.0}, {0.3, 0, 0}, {0.3, 0, 0.8});
+  ASSERT_GE(on, 0.0);
+  ASSERT_GE(off, 0.0);
+  EXPECT_LT(on, off);
+}
+
+TEST(LocalPlannerParams, RejectsNonsense) {
+  LocalPlannerParams p;
+  p.sim_time = 0.0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = LocalPlannerParams();
+  p.min_vel_x = 1.0;
+  p.max_vel_x = 0.5;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+}
