@@ -464,6 +464,15 @@ PYBIND11_MODULE(_core, m) {
           py::arg("costmap"), py::arg("pose"), py::arg("velocity"))
       .def("score_trajectory", &LocalPlanner::scoreTrajectory, py::arg("costmap"), py::arg("pose"), py::arg("velocity"),
            py::arg("command"))
+      .def(
+          "simulate",
+          [](const LocalPlanner& lp, const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
+             const Eigen::Vector3d& command) {
+            const mbot::core::Trajectory t = lp.simulate(map, pose, velocity, command);
+            return py::make_tuple(t.cost, t.progress, t.points);
+          },
+          py::arg("costmap"), py::arg("pose"), py::arg("velocity"), py::arg("command"))
+      .def("progress_at", &LocalPlanner::progressAt, py::arg("costmap"), py::arg("pose"))
       .def("update_grids", &LocalPlanner::updateGrids, py::arg("costmap"), py::arg("pose"))
       .def("reset_oscillation", &LocalPlanner::resetOscillation)
       .def_property_readonly("local_goal", [](const LocalPlanner& lp) { return Eigen::Vector2d(lp.localGoal()); })

@@ -272,7 +272,8 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
     th += vth * dt;
     time += dt;
   }
-  traj.cost = path_bias_ * path_dist + goal_bias_ * goal_dist + p.occdist_scale * occ + (p.heading_scoring ? 0.3 * heading : 0.0);
+  traj.progress = path_bias_ * path_dist + goal_bias_ * goal_dist;
+  traj.cost = traj.progress + p.occdist_scale * occ + (p.heading_scoring ? 0.3 * heading : 0.0);
 }
 
 double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
@@ -281,6 +282,19 @@ double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& 
   Trajectory t;
   generate(map, pose, velocity, command.x(), command.y(), command.z(), path_grid_.obstacle(), t);
   return t.cost;
+}
+
+Trajectory LocalPlanner::simulate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
+                                  const Eigen::Vector3d& command) const {
+  Trajectory t;
+  generate(map, pose, velocity, command.x(), command.y(), command.z(), path_grid_.obstacle(), t);
+  return t;
+}
+
+double LocalPlanner::progressAt(const Costmap& map, const Eigen::Vector3d& pose) const {
+  const Cell here = map.worldToCell(pose.head<2>());
+  if (!map.contains(here) || path_grid_.values().size() != map.costs().size()) return std::numeric_limits<double>::infinity();
+  return path_bias_ * path_grid_.at(here) + goal_bias_ * goal_grid_.at(here);
 }
 
 Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity) {
@@ -339,7 +353,12 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
 
   Trajectory best, comp;
   best.cost = -1.0;
-  auto better = [&](const Trajectory& t) { return t.cost >= 0 && (t.cost < best.cost || best.cost < 0); };
+  bool progressing = false;  // some valid forward trajectory ends nearer the plan and goal
+  const double progress_now = progressAt(map, pose);
+  auto better = [&](const Trajectory& t) {
+    if (t.cost >= 0 && t.xv > 0 && t.progress < progress_now - 1e-9) progressing = true;
+    return t.cost >= 0 && (t.cost < best.cost || best.cost < 0);
+  };
 
   if (!escaping_) {
     double vx_samp = min_vx;
@@ -365,7 +384,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   // Rotating in place, towards where the goal distance a heading_lookahead ahead is smallest.
   double heading_dist = std::numeric_limits<double>::max();
   double vth_samp = min_vth;
-  for (int i = 0; i < p.vtheta_samples; ++i) {
+  for (int i = 0; i < p.vtheta_samples && !progressing; ++i) {
     const double limited = vth_samp > 0 ? std::max(vth_samp, p.min_in_place_vel_theta) : std::min(vth_samp, -p.min_in_place_vel_theta);
     generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp);
     if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth && !comp.points.empty()) {

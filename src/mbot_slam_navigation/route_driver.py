@@ -6,6 +6,8 @@ Poses are (x [m], y [m], yaw [rad]) in the waypoints' frame; commands are (v [m/
 import math
 from typing import Optional, Sequence, Tuple
 
+from mbot_slam_navigation.transforms import normalize_angle
+
 # Through the simulated home (world frame, m): the living room, the study and back, the dining room
 # and the kitchen and back; every leg is a straight line clear of walls and furniture, with doors
 # crossed at their centres.
@@ -41,6 +43,6 @@ class RouteDriver:
             return None
         wx, wy = self.waypoints[self.index]
         bearing = math.atan2(wy - pose[1], wx - pose[0])
-        err = math.atan2(math.sin(bearing - pose[2]), math.cos(bearing - pose[2]))
+        err = normalize_angle(bearing - pose[2])
         w = max(-self.max_turn, min(self.max_turn, self.turn_gain * err))
         return (self.speed if abs(err) < 0.4 else 0.0), w

@@ -23,10 +23,15 @@ def planar(t: np.ndarray) -> Tuple[float, float, float]:
     return float(t[0, 3]), float(t[1, 3]), math.atan2(t[1, 0], t[0, 0])
 
 
+def normalize_angle(a: float) -> float:
+    """The angle [rad] wrapped into (-pi, pi]."""
+    return math.atan2(math.sin(a), math.cos(a))
+
+
 def compose2d(a: Sequence[float], b: Sequence[float]) -> Tuple[float, float, float]:
     """Planar pose composition a (+) b: b given in a's frame, returned in a's parent frame."""
     c, s = math.cos(a[2]), math.sin(a[2])
-    yaw = math.atan2(math.sin(a[2] + b[2]), math.cos(a[2] + b[2]))
+    yaw = normalize_angle(a[2] + b[2])
     return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], yaw
 
 

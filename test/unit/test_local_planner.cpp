@@ -135,6 +135,26 @@ TEST(LocalPlanner, ACentreInAnInscribedCellCanStillTurnOrBackOut) {
   EXPECT_TRUE(t.xv != 0.0 || t.thetav != 0.0);
 }
 
+TEST(LocalPlanner, ApproachesAGoalNearAWallInsteadOfSpinning) {
+  // The goal is 0.35 m from a wall, inside the inflation: every step towards it raises the
+  // occupancy term more than it lowers the distance terms (tutorial biases, meter_scoring), so
+  // ROS's rule, an in-place rotation wins when it scores lower, spins here forever.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int x = 0; x < 100; ++x) raw.setCost({x, 70}, cost::kLethal);  // wall at y = 3.5 m
+  const Costmap m = inflated(raw);
+  const Eigen::Vector3d pose(2.0, 2.8, 0.9);
+  LocalPlanner lp(tutorialParams(), padFootprint(circleFootprint(0.2), 0.01));
+  lp.setPlan(straightPlan({2.0, 2.8}, {2.4, 3.125}, 0.025));
+  lp.updateGrids(m, pose);
+  const double spin = lp.scoreTrajectory(m, pose, {0, 0, 0}, {0, 0, 0.5});
+  const double creep = lp.scoreTrajectory(m, pose, {0, 0, 0}, {0.05, 0, 0});
+  ASSERT_GE(spin, 0.0);
+  ASSERT_LE(spin, creep) << "the situation where ROS's rule prefers spinning";
+  const Trajectory t = lp.findBestPath(m, pose, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_GT(t.xv, 0.0);
+}
+
 TEST(LocalPlanner, BoxedInGivesNoCommand) {
   Costmap m(100, 100, 0.05, {0, 0});
   // A 0.5 m box of lethal cells around a 0.4 m robot: no turn, no back-up, no forward move.

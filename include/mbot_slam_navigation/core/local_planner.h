@@ -9,9 +9,15 @@
 // the footprint outline touches a lethal or unknown cell or leaves the map, and (-2) if it enters a
 // cell with no path to the goal. With meter_scoring the two biases are multiplied by the costmap
 // resolution, so the distances count in metres.
-// When no forward trajectory is valid it rotates in place towards the goal (with min_in_place
-// speed), then strafes (holonomic), then backs up at escape_vel, with ROS's oscillation flags
-// (no turning back the way it just turned until it moved oscillation_reset_dist) and escape mode.
+// Rotating in place (at least min_in_place_vel_theta, towards the goal) is considered when no
+// forward trajectory gets closer to the plan and goal than the robot is now; then strafes
+// (holonomic), then backing up at escape_vel, with ROS's oscillation flags (no turning back the
+// way it just turned until it moved oscillation_reset_dist) and escape mode.
+// One deliberate difference: ROS also lets an in-place rotation win whenever it merely scores
+// lower than the best forward trajectory. Near a wall the occupancy term of every forward move
+// grows faster than its distance terms shrink (with meter_scoring and the tutorials' biases), so
+// ROS's robot spins in place there until move_base gives up; here a forward move that makes
+// progress is always preferred to spinning on the spot.
 //
 // Frames: every pose is in the local costmap's global frame (x [m], y [m], yaw [rad]); velocities
 // are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
@@ -58,6 +64,7 @@ struct LocalPlannerParams {
 struct Trajectory {
   double xv = 0.0, yv = 0.0, thetav = 0.0;  ///< the sampled command
   double cost = -1.0;                       ///< < 0: invalid (-1 collision, -2 no path to goal)
+  double progress = 0.0;                    ///< the distance terms alone at the last point
   std::vector<Eigen::Vector3d> points;      ///< simulated poses (x, y, yaw)
 };
 
@@ -108,6 +115,11 @@ class LocalPlanner {
   /// findBestPath / updateGrids); >= 0 means the command is safe.
   double scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
                          const Eigen::Vector3d& command);
+  /// The whole simulated trajectory of one command (for inspection and tests).
+  Trajectory simulate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
+                      const Eigen::Vector3d& command) const;
+  /// The distance terms at the robot's own cell (what a trajectory must beat to make progress).
+  double progressAt(const Costmap& map, const Eigen::Vector3d& pose) const;
   /// Recomputes the path and goal distance grids for `pose` without choosing a command.
   void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
   /// Clears the oscillation and escape state (a new goal).

@@ -51,3 +51,27 @@ def occupied_points(msg, threshold: int = 65) -> np.ndarray:
     rows, cols = np.nonzero(data >= threshold)
     res, o = msg.info.resolution, msg.info.origin.position
     return np.column_stack([o.x + (cols + 0.5) * res, o.y + (rows + 0.5) * res])
+
+
+def rasterize(world: World, resolution: float = 0.05, margin: float = 0.5) -> Tuple[np.ndarray, Tuple[float, float]]:
+    """A perfect map of the world: (OccupancyGrid data (rows = y): 100 inside or on a shape, 0 elsewhere,
+    origin (x, y) [m] of cell (0, 0)), covering every shape plus ``margin``. A test fixture standing in
+    for a saved map where localization is not under test."""
+    segs, circles = surfaces(world)
+    xs = np.concatenate([segs[:, 0], segs[:, 2], circles[:, 0] - circles[:, 2], circles[:, 0] + circles[:, 2]])
+    ys = np.concatenate([segs[:, 1], segs[:, 3], circles[:, 1] - circles[:, 2], circles[:, 1] + circles[:, 2]])
+    x0, y0 = math.floor((xs.min() - margin) / resolution) * resolution, math.floor((ys.min() - margin) / resolution) * resolution
+    w = int(math.ceil((xs.max() + margin - x0) / resolution))
+    h = int(math.ceil((ys.max() + margin - y0) / resolution))
+    gx, gy = np.meshgrid(x0 + (np.arange(w) + 0.5) * resolution, y0 + (np.arange(h) + 0.5) * resolution)
+    pts = np.column_stack([gx.ravel(), gy.ravel()])
+    occupied = distance_to_surfaces(world, pts) <= 0.5 * resolution
+    for s in world.shapes:  # cell centres inside a solid
+        if s.kind == 'circle':
+            occupied |= np.hypot(pts[:, 0] - s.x, pts[:, 1] - s.y) <= s.radius
+        else:
+            c, si = math.cos(s.yaw), math.sin(s.yaw)
+            dx, dy = pts[:, 0] - s.x, pts[:, 1] - s.y
+            u, v = c * dx + si * dy, -si * dx + c * dy
+            occupied |= (np.abs(u) <= s.size_x / 2) & (np.abs(v) <= s.size_y / 2)
+    return np.where(occupied, 100, 0).astype(np.int8).reshape(h, w), (x0, y0)

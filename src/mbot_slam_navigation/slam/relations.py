@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mbot_slam_navigation.transforms import compose2d, inverse2d, relative2d
+from mbot_slam_navigation.transforms import compose2d, inverse2d, normalize_angle, relative2d
 
 
 @dataclass
@@ -56,7 +56,7 @@ def pose_at(times: np.ndarray, poses: np.ndarray, t: float, max_gap: float = 0.1
         return None
     a = (t - t0) / (t1 - t0) if t1 > t0 else 0.0
     p0, p1 = poses[i - 1], poses[i]
-    dyaw = math.atan2(math.sin(p1[2] - p0[2]), math.cos(p1[2] - p0[2]))
+    dyaw = normalize_angle(p1[2] - p0[2])
     return np.array([p0[0] + a * (p1[0] - p0[0]), p0[1] + a * (p1[1] - p0[1]), p0[2] + a * dyaw])
 
 
@@ -71,7 +71,7 @@ def evaluate(times: np.ndarray, poses: np.ndarray, relations: np.ndarray, max_ga
             continue
         err = compose2d(relative2d(p1, p2), inverse2d((x, y, yaw)))
         trans.append(math.hypot(err[0], err[1]))
-        rot.append(abs(math.degrees(math.atan2(math.sin(err[2]), math.cos(err[2])))))
+        rot.append(abs(math.degrees(normalize_angle(err[2]))))
     trans, rot = np.array(trans), np.array(rot)
     if len(trans) == 0:
         raise ValueError('no relation could be evaluated: are the trajectory times those of the log?')

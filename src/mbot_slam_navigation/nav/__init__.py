@@ -1,0 +1,1 @@
+"""move_base and its parts: costmaps, planners, recoveries."""
