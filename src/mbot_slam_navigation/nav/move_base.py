@@ -483,6 +483,12 @@ class MoveBase:
                     return False
 
         if self.state == CLEARING:
+            if self.recovery_trigger == 'planning' and self.why.startswith(('goal occupied', 'goal off the costmap')):
+                # Turning or backing up cannot free a goal cell or bring it onto the map; only
+                # clearing the costmaps might, so the motion recoveries are skipped.
+                while self.recovery_index < len(self.recoveries) and \
+                        self.recoveries[self.recovery_index][1] != RECOVERY_TYPES[0]:
+                    self.recovery_index += 1
             if self.recovery_behavior_enabled and self.recovery_index < len(self.recoveries):
                 name, kind, cfg = self.recoveries[self.recovery_index]
                 rospy.logwarn('move_base: %s (%s); running recovery behaviour %s' % (

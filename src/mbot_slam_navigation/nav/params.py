@@ -120,8 +120,11 @@ class ParamReader:
             if elsewhere and key in elsewhere:
                 self.warn('parameter %s has no effect here: %s is a parameter of %s' % (self.where(key), key, elsewhere[key]))
                 continue
-            guess = nearest_key(key, self.read_keys | skip)
-            if guess:
+            guess = nearest_key(key, self.read_keys | skip | set(elsewhere or ()))
+            if guess and elsewhere and guess in elsewhere and guess not in self.read_keys:
+                self.warn('unknown parameter %s (did you mean %s? that is a parameter of %s, not of this namespace); '
+                          'it is ignored' % (self.where(key), guess, elsewhere[guess]))
+            elif guess:
                 self.warn('unknown parameter %s (did you mean %s?); it is ignored' % (self.where(key), guess))
             else:
                 self.warn('unknown parameter %s; it is ignored' % self.where(key))
