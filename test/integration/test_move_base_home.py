@@ -87,7 +87,7 @@ class MoveBaseHomeTest(unittest.TestCase):
         req.start.header.frame_id = req.goal.header.frame_id = 'map'
         req.start.pose.position.x, req.start.pose.position.y = 0.0, 0.0
         req.goal.pose.position.x, req.goal.pose.position.y = A[0], A[1]
-        req.start.pose.orientation.w = req.goal.pose.orientation.w = 1.0
+        # Orientations left all zero, as GetPlan clients often send them.
         plan = make_plan(req).plan
         self.assertGreater(len(plan.poses), 10)
         first, last = plan.poses[0].pose.position, plan.poses[-1].pose.position

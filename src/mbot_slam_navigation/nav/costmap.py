@@ -63,7 +63,8 @@ class ObservationSource:
         r = ParamReader(values, '%s/%s' % (layer.ns, name), warn)
         self.name = name
         self.topic = r.string('topic', name)
-        self.sensor_frame = r.frame('sensor_frame', '/') if r.has('sensor_frame') and r.values['sensor_frame'] else ''
+        # Empty (the default): the frame of each scan's header.
+        self.sensor_frame = r.frame('sensor_frame', '') if r.raw('sensor_frame', '') else ''
         self.observation_persistence = r.number('observation_persistence', 0.0, minimum=0.0)
         self.expected_update_rate = r.number('expected_update_rate', 0.0, minimum=0.0)
         self.data_type = r.string('data_type', 'PointCloud')

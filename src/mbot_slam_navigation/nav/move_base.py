@@ -208,9 +208,17 @@ class MoveBase:
         action_goal.goal.target_pose = msg
         self.action_goal_pub.publish(action_goal)
 
-    def _goal_in_frame(self, pose: PoseStamped, frame: str) -> Tuple[Optional[Tuple[float, float, float]], str]:
-        """The goal as (x, y, yaw) in ``frame`` (tf2 for another frame), or (None, why)."""
-        yaw, note = check_quaternion(pose.pose.orientation)
+    def _goal_in_frame(self, pose: PoseStamped, frame: str,
+                       heading_required: bool = True) -> Tuple[Optional[Tuple[float, float, float]], str]:
+        """The goal as (x, y, yaw) in ``frame`` (tf2 for another frame), or (None, why).
+
+        ``heading_required`` False (make_plan requests, which often leave the orientation all zero)
+        reads a zero quaternion as yaw 0 instead of refusing it."""
+        o = pose.pose.orientation
+        if not heading_required and (o.x, o.y, o.z, o.w) == (0.0, 0.0, 0.0, 0.0):
+            yaw, note = 0.0, ''
+        else:
+            yaw, note = check_quaternion(o)
         if yaw is None:
             return None, note
         if note:
@@ -262,10 +270,10 @@ class MoveBase:
         resp.plan.header.frame_id = frame
         resp.plan.header.stamp = rospy.Time.now()
         if req.start.header.frame_id:
-            start, why = self._goal_in_frame(req.start, frame)
+            start, why = self._goal_in_frame(req.start, frame, heading_required=False)
         else:
             start, why = self.global_costmap.lookup_robot_pose(), self.global_costmap.tf_problem
-        goal, why_goal = self._goal_in_frame(req.goal, frame)
+        goal, why_goal = self._goal_in_frame(req.goal, frame, heading_required=False)
         if start is None or goal is None:
             rospy.logerr('make_plan: %s' % (why or why_goal))
             return resp
