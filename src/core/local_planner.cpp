@@ -381,21 +381,26 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     }
   }
 
+  // The goal distance heading_lookahead ahead of a trajectory's end (how well it faces the goal);
+  // +inf when that point is off the map or the trajectory empty.
+  auto goalDistanceAhead = [&](const Trajectory& t) {
+    if (t.points.empty()) return std::numeric_limits<double>::infinity();
+    const Eigen::Vector3d& e = t.points.back();
+    const Cell ahead = map.worldToCell({e.x() + p.heading_lookahead * std::cos(e.z()), e.y() + p.heading_lookahead * std::sin(e.z())});
+    return map.contains(ahead) ? static_cast<double>(goal_grid_.at(ahead)) : std::numeric_limits<double>::infinity();
+  };
+
   // Rotating in place, towards where the goal distance a heading_lookahead ahead is smallest.
   double heading_dist = std::numeric_limits<double>::max();
   double vth_samp = min_vth;
   for (int i = 0; i < p.vtheta_samples && !progressing; ++i) {
     const double limited = vth_samp > 0 ? std::max(vth_samp, p.min_in_place_vel_theta) : std::min(vth_samp, -p.min_in_place_vel_theta);
     generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp);
-    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth && !comp.points.empty()) {
-      const Eigen::Vector3d& e = comp.points.back();
-      const Cell ahead = map.worldToCell({e.x() + p.heading_lookahead * std::cos(e.z()), e.y() + p.heading_lookahead * std::sin(e.z())});
-      if (map.contains(ahead)) {
-        const double d = goal_grid_.at(ahead);
-        if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
-          std::swap(best, comp);
-          heading_dist = d;
-        }
+    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth) {
+      const double d = goalDistanceAhead(comp);
+      if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
+        std::swap(best, comp);
+        heading_dist = d;
       }
     }
     vth_samp += dvth;
@@ -408,15 +413,11 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   if (p.holonomic_robot) {
     for (double vy : p.y_vels) {
       generate(map, pose, vel, 0.0, vy, 0.0, impossible, comp);
-      if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0) && !comp.points.empty()) {
-        const Eigen::Vector3d& e = comp.points.back();
-        const Cell ahead = map.worldToCell({e.x() + p.heading_lookahead * std::cos(e.z()), e.y() + p.heading_lookahead * std::sin(e.z())});
-        if (map.contains(ahead)) {
-          const double d = goal_grid_.at(ahead);
-          if (d < heading_dist && ((vy > 0 && !stuck_left_strafe_) || (vy < 0 && !stuck_right_strafe_))) {
-            std::swap(best, comp);
-            heading_dist = d;
-          }
+      if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0)) {
+        const double d = goalDistanceAhead(comp);
+        if (d < heading_dist && ((vy > 0 && !stuck_left_strafe_) || (vy < 0 && !stuck_right_strafe_))) {
+          std::swap(best, comp);
+          heading_dist = d;
         }
       }
     }
@@ -431,8 +432,8 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   // collides; here backing up must itself be collision-free, though it may leave the cells that
   // have a path distance (that is how a robot gets out of an inscribed pocket).
   generate(map, pose, vel, p.escape_vel, 0.0, 0.0, std::numeric_limits<double>::infinity(), comp);
-  resetFlagsIfMoved(pose);
   if (comp.cost < 0) {
+    resetFlagsIfMoved(pose);
     best.cost = -1.0;  // boxed in: no safe command at all
     return best;
   }

@@ -113,13 +113,15 @@ class CostmapConfig:
             r.read_keys.add('footprint')
             radius = r.number('robot_radius', 0.46, positive=True)
             footprint = [tuple(p) for p in _core._circle_footprint(radius)]
+        points = [np.array(p, float) for p in footprint]
         try:
-            _core._validate_footprint([np.array(p) for p in footprint])
+            _core._validate_footprint(points)
         except ValueError as e:
             raise ParamError('parameter %s: %s' % (r.where('footprint'), e))
-        self.footprint = [tuple(p) for p in _core._pad_footprint([np.array(p) for p in footprint], self.footprint_padding)]
-        self.inscribed_radius = _core._inscribed_radius([np.array(p) for p in self.footprint])
-        self.circumscribed_radius = _core._circumscribed_radius([np.array(p) for p in self.footprint])
+        padded = _core._pad_footprint(points, self.footprint_padding)
+        self.footprint = [tuple(p) for p in padded]
+        self.inscribed_radius = _core._inscribed_radius(padded)
+        self.circumscribed_radius = _core._circumscribed_radius(padded)
 
         self.layers = []  # (name, kind, ParamReader of the layer's own keys + top-level fallbacks)
         sub_namespaces = set()

@@ -23,6 +23,7 @@ from geometry_msgs.msg import PoseStamped, Twist
 from move_base_msgs.msg import MoveBaseAction, MoveBaseActionGoal, MoveBaseFeedback, MoveBaseResult
 from nav_msgs.msg import Odometry, Path
 from nav_msgs.srv import GetPlan, GetPlanResponse
+from std_msgs.msg import Header
 from std_srvs.srv import Empty, EmptyResponse
 
 from mbot_slam_navigation import _core
@@ -55,6 +56,16 @@ def check_quaternion(q) -> Tuple[Optional[float], str]:
     if up < 1.0 - 1e-3:
         return None, 'the goal orientation tilts the robot (its z axis must stay vertical for planar navigation)'
     return quaternion_to_yaw(x, y, z, w), warning
+
+
+def pose_stamped(header, x: float, y: float, yaw: float) -> PoseStamped:
+    """A planar pose as geometry_msgs/PoseStamped (``header`` is copied)."""
+    ps = PoseStamped()
+    ps.header = header
+    ps.pose.position.x, ps.pose.position.y = float(x), float(y)
+    o = ps.pose.orientation
+    o.x, o.y, o.z, o.w = yaw_to_quaternion(yaw)
+    return ps
 
 
 class MoveBase:
@@ -255,12 +266,7 @@ class MoveBase:
         msg.header.stamp = rospy.Time.now()
         msg.header.frame_id = frame
         for i, (x, y) in enumerate(path):
-            ps = PoseStamped()
-            ps.header = msg.header
-            ps.pose.position.x, ps.pose.position.y = float(x), float(y)
-            q = yaw_to_quaternion(yaw if yaw is not None and i == len(path) - 1 else 0.0)
-            ps.pose.orientation.x, ps.pose.orientation.y, ps.pose.orientation.z, ps.pose.orientation.w = q
-            msg.poses.append(ps)
+            msg.poses.append(pose_stamped(msg.header, x, y, yaw if yaw is not None and i == len(path) - 1 else 0.0))
         for pub in pubs:
             pub.publish(msg)
 
@@ -288,13 +294,7 @@ class MoveBase:
                                                                                      goal[1], why))
             return resp
         for i, (x, y) in enumerate(path):
-            ps = PoseStamped()
-            ps.header = resp.plan.header
-            ps.pose.position.x, ps.pose.position.y = float(x), float(y)
-            yaw = goal[2] if i == len(path) - 1 else 0.0
-            q = yaw_to_quaternion(yaw)
-            ps.pose.orientation.x, ps.pose.orientation.y, ps.pose.orientation.z, ps.pose.orientation.w = q
-            resp.plan.poses.append(ps)
+            resp.plan.poses.append(pose_stamped(resp.plan.header, x, y, goal[2] if i == len(path) - 1 else 0.0))
         return resp
 
     def _on_clear_costmaps(self, _req) -> EmptyResponse:
@@ -314,12 +314,8 @@ class MoveBase:
                                     'quaternion or frame: %s' % why)
             rospy.logerr('move_base: goal rejected: %s' % why)
             return None
-        ps = PoseStamped()
-        ps.header.frame_id = self.global_costmap.config.global_frame
-        ps.header.stamp = rospy.Time.now()
-        ps.pose.position.x, ps.pose.position.y = goal[0], goal[1]
-        q = yaw_to_quaternion(goal[2])
-        ps.pose.orientation.x, ps.pose.orientation.y, ps.pose.orientation.z, ps.pose.orientation.w = q
+        header = Header(frame_id=self.global_costmap.config.global_frame, stamp=rospy.Time.now())
+        ps = pose_stamped(header, *goal)
         self.goal_pub.publish(ps)
         rospy.loginfo('move_base: new goal (%.2f, %.2f, %.2f rad) in %s' % (goal[0], goal[1], goal[2], ps.header.frame_id))
         return goal
@@ -393,14 +389,8 @@ class MoveBase:
                 return self._abort('Robot pose unavailable for more than controller_patience %.1f s (%s)'
                                    % (self.controller_patience, why))
             return False
-        feedback = MoveBaseFeedback()
-        feedback.base_position.header.frame_id = self.global_costmap.config.global_frame
-        feedback.base_position.header.stamp = now
-        feedback.base_position.pose.position.x, feedback.base_position.pose.position.y = pose[0], pose[1]
-        q = yaw_to_quaternion(pose[2])
-        o = feedback.base_position.pose.orientation
-        o.x, o.y, o.z, o.w = q
-        self.server.publish_feedback(feedback)
+        header = Header(frame_id=self.global_costmap.config.global_frame, stamp=now)
+        self.server.publish_feedback(MoveBaseFeedback(base_position=pose_stamped(header, *pose)))
 
         if self.oscillation_pose is None or math.hypot(pose[0] - self.oscillation_pose[0],
                                                        pose[1] - self.oscillation_pose[1]) >= self.oscillation_distance:
