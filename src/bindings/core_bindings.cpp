@@ -11,6 +11,7 @@
 #include "mbot_slam_navigation/core/costmap.h"
 #include "mbot_slam_navigation/core/footprint.h"
 #include "mbot_slam_navigation/core/local_planner.h"
+#include "mbot_slam_navigation/core/map_image.h"
 #include "mbot_slam_navigation/core/obstacle_layer.h"
 #include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
@@ -48,6 +49,25 @@ LaserScan toScan(double angle_min, double angle_increment, double range_min, dou
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of mbot_slam_navigation (private: use the wrappers in mbot_slam_navigation)";
+
+  m.def(
+      "_load_map_image",
+      [](const std::string& path, double occupied_thresh, double free_thresh, bool negate, const std::string& mode) {
+        mbot::core::MapImageParams p;
+        p.occupied_thresh = occupied_thresh;
+        p.free_thresh = free_thresh;
+        p.negate = negate;
+        if (mode == "trinary") p.mode = mbot::core::MapMode::kTrinary;
+        else if (mode == "scale") p.mode = mbot::core::MapMode::kScale;
+        else if (mode == "raw") p.mode = mbot::core::MapMode::kRaw;
+        else throw std::invalid_argument("mode must be trinary, scale or raw, not \"" + mode + "\"");
+        const auto img = mbot::core::loadMapImage(path, p);
+        py::array_t<int8_t> out({img.height, img.width});
+        std::copy(img.data.begin(), img.data.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("path"), py::arg("occupied_thresh"), py::arg("free_thresh"), py::arg("negate"), py::arg("mode"),
+      "map_server's pixel rules: (height, width) int8 occupancy, row 0 = the image's bottom row");
 
   py::class_<LogOddsModel>(m, "_LogOddsModel")
       .def(py::init<>())
