@@ -168,7 +168,7 @@ void Amcl::initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov)
     for (int i = 0; i < 3; ++i) l(i, i) = std::sqrt(std::max(0.0, cov(i, i)));
   }
   std::normal_distribution<double> n01(0.0, 1.0);
-  particles_.assign(params_.max_particles, Particle{mean, 1.0 / params_.max_particles});
+  particles_.assign(params_.max_particles, AmclParticle{mean, 1.0 / params_.max_particles});
   for (auto& p : particles_) {
     const Eigen::Vector3d z(n01(rng_), n01(rng_), n01(rng_));
     p.pose = mean + l * z;
@@ -190,7 +190,7 @@ Eigen::Vector3d Amcl::randomFreePose() {
 void Amcl::initUniform() {
   if (!map_ || map_->freeCells().empty()) throw std::logic_error("amcl: global localization needs a map with free cells");
   particles_.resize(params_.max_particles);
-  for (auto& p : particles_) p = Particle{randomFreePose(), 1.0 / params_.max_particles};
+  for (auto& p : particles_) p = AmclParticle{randomFreePose(), 1.0 / params_.max_particles};
   w_slow_ = w_fast_ = 0.0;
 }
 
@@ -379,10 +379,10 @@ void Amcl::resample() {
   }
   n = std::max(n, params_.min_particles);
 
-  std::vector<Particle> next;
+  std::vector<AmclParticle> next;
   next.reserve(n);
   for (int idx : systematic(n)) {
-    next.push_back(Particle{w_diff > 0.0 && unit(rng_) < w_diff ? randomFreePose() : particles_[idx].pose, 1.0 / n});
+    next.push_back(AmclParticle{w_diff > 0.0 && unit(rng_) < w_diff ? randomFreePose() : particles_[idx].pose, 1.0 / n});
   }
   particles_.swap(next);
   if (w_diff > 0.0) w_slow_ = w_fast_ = 0.0;  // as ROS: start averaging afresh after an injection

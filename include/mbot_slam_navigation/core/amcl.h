@@ -87,7 +87,7 @@ struct AmclParams {
   void validate() const;
 };
 
-struct Particle {
+struct AmclParticle {
   Eigen::Vector3d pose;  ///< base in the map frame
   double weight;
 };
@@ -124,7 +124,7 @@ class Amcl {
   void resample();
 
   AmclEstimate estimate() const;
-  const std::vector<Particle>& particles() const { return particles_; }
+  const std::vector<AmclParticle>& particles() const { return particles_; }
   /// Recovery averages of the total likelihood (ROS's w_slow, w_fast).
   double wSlow() const { return w_slow_; }
   double wFast() const { return w_fast_; }
@@ -138,7 +138,7 @@ class Amcl {
   AmclParams params_;
   std::mt19937 rng_;
   std::shared_ptr<const AmclMap> map_;
-  std::vector<Particle> particles_;
+  std::vector<AmclParticle> particles_;
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;
   // The likelihood field as pz^3 per cell for the last (params, range_max): one lookup per beam.

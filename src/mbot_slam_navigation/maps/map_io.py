@@ -63,8 +63,10 @@ def save_map(basename: str, data: np.ndarray, resolution: float, origin: Sequenc
                   + img.tobytes())
     read_occ = max(float(occupied_thresh), 0.197)
     read_free = min(float(free_thresh), round(_UNKNOWN_OCC, 3))
-    meta = {'image': os.path.basename(basename) + '.pgm', 'resolution': float(resolution),
-            'origin': [float(origin[0]), float(origin[1]), float(origin[2]) if len(origin) > 2 else 0.0],
+    # Six decimals, as map_saver's %f: a float32 resolution from a message (0.05000000074505806) or
+    # an origin summed from cells (-5.199999999999999) reads back as what it means.
+    meta = {'image': os.path.basename(basename) + '.pgm', 'resolution': round(float(resolution), 6),
+            'origin': [round(float(v), 6) for v in (origin[0], origin[1], origin[2] if len(origin) > 2 else 0.0)],
             'negate': 0, 'occupied_thresh': read_occ, 'free_thresh': read_free}
     text = yaml.safe_dump(meta, default_flow_style=None, sort_keys=False)
     if (read_occ, read_free) != (occupied_thresh, free_thresh):

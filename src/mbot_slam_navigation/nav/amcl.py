@@ -1,0 +1,401 @@
+"""amcl: ROS amcl's node over the C++ particle filter (include/mbot_slam_navigation/core/amcl.h).
+
+Interface as ROS's amcl: subscribes `scan`, `initialpose` (rviz's 2D Pose Estimate), `map` (with
+use_map_topic, otherwise the map comes once from the `static_map` service); publishes `amcl_pose`
+(latched), `particlecloud` (latched) and map -> odom on tf (future-dated by transform_tolerance,
+unless tf_broadcast is false); serves `global_localization`, `request_nomotion_update` and
+`set_map`. Parameters: ROS amcl's names and defaults (parameters_of()).
+
+Differences from ROS, on purpose: "diff" and "omni" are the corrected odometry models (ROS's
+"-corrected" ones: sqrt(alpha * motion^2) is the standard deviation); yaw bins wrap when clusters are
+formed; resampling is low-variance and linear in the particle count; a second publisher of map ->
+odom while tf_broadcast is true is reported as an error (the robot would jump between the two).
+"""
+import math
+import threading
+from typing import Optional, Tuple
+
+import numpy as np
+import rospy
+import tf2_ros
+from geometry_msgs.msg import Pose, PoseArray, PoseWithCovarianceStamped, TransformStamped
+from nav_msgs.msg import OccupancyGrid
+from nav_msgs.srv import GetMap, SetMap, SetMapResponse
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
+
+from mbot_slam_navigation import _core
+from mbot_slam_navigation.nav.params import ParamError, ParamReader
+from mbot_slam_navigation.transforms import compose2d, inverse2d, normalize_angle, quaternion_to_yaw, yaw_to_quaternion
+
+ODOM_MODELS = {'diff': 'diff', 'diff-corrected': 'diff', 'omni': 'omni', 'omni-corrected': 'omni'}
+LASER_MODELS = {'likelihood_field': 'likelihood_field', 'likelihood_field_prob': 'likelihood_field', 'beam': 'beam'}
+# ROS amcl parameters this node accepts but does not implement (beam skipping, selective resampling).
+IGNORED = ('do_beamskip', 'beam_skip_distance', 'beam_skip_threshold', 'beam_skip_error_threshold',
+           'selective_resampling', 'restore_defaults')
+THROTTLE = 10.0  # [s] between repeats of one warning
+
+
+def read_parameters(r: ParamReader):
+    """ROS amcl's parameters and defaults, checked; returns (core params, node settings dict)."""
+    p = _core._AmclParams()
+    p.min_particles = r.integer('min_particles', 100, minimum=1)
+    p.max_particles = r.integer('max_particles', 5000, minimum=1)
+    if p.max_particles < p.min_particles:
+        raise ParamError('parameter %s (%d) must be >= %s (%d)' % (r.where('max_particles'), p.max_particles,
+                                                                 r.where('min_particles'), p.min_particles))
+    p.kld_err = r.number('kld_err', 0.01, positive=True)
+    p.kld_z = r.number('kld_z', 0.99, positive=True)
+    p.recovery_alpha_slow = r.number('recovery_alpha_slow', 0.0, minimum=0.0)
+    p.recovery_alpha_fast = r.number('recovery_alpha_fast', 0.0, minimum=0.0)
+    odom_model = r.string('odom_model_type', 'diff')
+    if odom_model not in ODOM_MODELS:
+        raise ParamError('parameter %s must be one of %s, got %r' % (r.where('odom_model_type'),
+                                                                     ', '.join(ODOM_MODELS), odom_model))
+    p.odom_model = ODOM_MODELS[odom_model]
+    for i in range(1, 6):
+        setattr(p, 'alpha%d' % i, r.number('odom_alpha%d' % i, 0.2, minimum=0.0))
+    laser_model = r.string('laser_model_type', 'likelihood_field')
+    if laser_model not in LASER_MODELS:
+        raise ParamError('parameter %s must be one of %s, got %r' % (r.where('laser_model_type'),
+                                                                     ', '.join(LASER_MODELS), laser_model))
+    if laser_model == 'likelihood_field_prob':
+        r.warn('parameter %s: likelihood_field_prob is run as likelihood_field (no beam skipping)'
+               % r.where('laser_model_type'))
+    p.laser_model = LASER_MODELS[laser_model]
+    p.max_beams = r.integer('laser_max_beams', 30, minimum=2)
+    p.z_hit = r.number('laser_z_hit', 0.95, minimum=0.0)
+    p.z_short = r.number('laser_z_short', 0.1, minimum=0.0)
+    p.z_max = r.number('laser_z_max', 0.05, minimum=0.0)
+    p.z_rand = r.number('laser_z_rand', 0.05, minimum=0.0)
+    p.sigma_hit = r.number('laser_sigma_hit', 0.2, positive=True)
+    p.lambda_short = r.number('laser_lambda_short', 0.1, positive=True)
+    p.likelihood_max_dist = r.number('laser_likelihood_max_dist', 2.0, positive=True)
+    try:
+        p.validate()
+    except ValueError as e:
+        raise ParamError('%s: %s' % (r.ns, e)) from None
+    s = {
+        'update_min_d': r.number('update_min_d', 0.2, minimum=0.0),
+        'update_min_a': r.number('update_min_a', math.pi / 6.0, minimum=0.0),
+        'resample_interval': r.integer('resample_interval', 2, minimum=1),
+        'transform_tolerance': r.number('transform_tolerance', 0.1, minimum=0.0),
+        'gui_publish_rate': r.number('gui_publish_rate', -1.0),
+        'save_pose_rate': r.number('save_pose_rate', 0.5),
+        'use_map_topic': r.boolean('use_map_topic', False),
+        'first_map_only': r.boolean('first_map_only', False),
+        'laser_min_range': r.number('laser_min_range', -1.0),
+        'laser_max_range': r.number('laser_max_range', -1.0),
+        'odom_frame_id': r.frame('odom_frame_id', 'odom'),
+        'base_frame_id': r.frame('base_frame_id', 'base_link'),
+        'global_frame_id': r.frame('global_frame_id', 'map'),
+        'tf_broadcast': r.boolean('tf_broadcast', True),
+        'initial_pose': (r.number('initial_pose_x', 0.0), r.number('initial_pose_y', 0.0),
+                         r.number('initial_pose_a', 0.0)),
+        'initial_cov': (r.number('initial_cov_xx', 0.5 * 0.5, minimum=0.0),
+                        r.number('initial_cov_yy', 0.5 * 0.5, minimum=0.0),
+                        r.number('initial_cov_aa', (math.pi / 12) ** 2, minimum=0.0)),
+        'seed': r.integer('seed', 0, minimum=0),
+    }
+    for key in IGNORED:
+        if r.has(key):
+            r.raw(key)
+            r.warn('parameter %s is not implemented here and is ignored' % r.where(key))
+    return p, s
+
+
+def pose_msg(x: float, y: float, yaw: float) -> Pose:
+    pose = Pose()
+    pose.position.x, pose.position.y = x, y
+    q = pose.orientation
+    q.x, q.y, q.z, q.w = yaw_to_quaternion(yaw)
+    return pose
+
+
+class AmclNode:
+    def __init__(self):
+        r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+        try:
+            self.params, self.s = read_parameters(r)
+        except ParamError as e:
+            rospy.logfatal('amcl: %s', e)
+            raise SystemExit(1)
+        r.report_unknown()
+        self.lock = threading.RLock()
+        self.pf = _core._Amcl(self.params, self.s['seed'])
+        self.map_received = False
+        self.pf_odom_pose: Optional[Tuple[float, float, float]] = None  # base in odom at the last filter update
+        self.force_update = False
+        self.resample_count = 0
+        self.laser_cache = {}   # frame_id -> (x, y, angle_min, angle_increment, sign) in the base frame
+        self.map_to_odom: Optional[Tuple[float, float, float]] = None
+        self.last_estimate: Optional[Tuple[float, float, float]] = None
+        self.last_cloud_time = rospy.Time(0)
+        self.other_tf_publishers = set()
+
+        self.tf = tf2_ros.Buffer(rospy.Duration(30.0))
+        self.tf_listener = tf2_ros.TransformListener(self.tf)
+        self.tf_pub = tf2_ros.TransformBroadcaster()
+        self.pose_pub = rospy.Publisher('amcl_pose', PoseWithCovarianceStamped, queue_size=2, latch=True)
+        self.cloud_pub = rospy.Publisher('particlecloud', PoseArray, queue_size=2, latch=True)
+        rospy.Service('global_localization', Empty, self.global_localization)
+        rospy.Service('request_nomotion_update', Empty, self.nomotion_update)
+        rospy.Service('set_map', SetMap, self.set_map)
+        rospy.Subscriber('/tf', TFMessage, self.watch_tf, queue_size=50)
+        rospy.Subscriber('initialpose', PoseWithCovarianceStamped, self.initial_pose, queue_size=2)
+        if self.s['use_map_topic']:
+            self.map_sub = rospy.Subscriber('map', OccupancyGrid, self.map_received_cb, queue_size=1)
+            rospy.loginfo('amcl: waiting for a map on %s', self.map_sub.resolved_name)
+        else:
+            self.request_map()
+        rospy.Subscriber('scan', LaserScan, self.scan_received, queue_size=1, buff_size=2 ** 22)
+        if self.s['save_pose_rate'] > 0:
+            rospy.Timer(rospy.Duration(1.0 / self.s['save_pose_rate']), self.save_pose)
+
+    # ---------------------------------------------------------------------------------------- map
+    def request_map(self):
+        rospy.loginfo('amcl: requesting the map from the static_map service...')
+        while not rospy.is_shutdown():
+            try:
+                rospy.wait_for_service('static_map', timeout=5.0)
+                self.handle_map(rospy.ServiceProxy('static_map', GetMap)().map)
+                return
+            except (rospy.ROSException, rospy.ServiceException) as e:
+                rospy.logwarn_throttle(THROTTLE, 'amcl: no map from static_map yet (%s); is map_server running? '
+                                                 'Or set use_map_topic true to read the map topic' % e)
+
+    def map_received_cb(self, msg: OccupancyGrid):
+        if self.s['first_map_only'] and self.map_received:
+            return
+        self.handle_map(msg)
+
+    def handle_map(self, msg: OccupancyGrid) -> bool:
+        info = msg.info
+        if info.width * info.height != len(msg.data) or info.resolution <= 0:
+            rospy.logerr('amcl: map in frame "%s" is malformed (%d x %d cells, %d values, resolution %g); ignored',
+                         msg.header.frame_id, info.width, info.height, len(msg.data), info.resolution)
+            return False
+        q = info.origin.orientation
+        yaw = quaternion_to_yaw(q.x, q.y, q.z, q.w)
+        if abs(yaw) > 1e-6:
+            rospy.logwarn('amcl: the map origin is rotated by %.3f rad; amcl uses its position only, as ROS amcl', yaw)
+        if msg.header.frame_id and msg.header.frame_id.lstrip('/') != self.s['global_frame_id']:
+            rospy.logwarn('amcl: the map is in frame "%s" but global_frame_id is "%s"', msg.header.frame_id,
+                          self.s['global_frame_id'])
+        data = np.asarray(msg.data, dtype=np.int8).reshape(info.height, info.width)
+        amap = _core._AmclMap(data, info.resolution, (info.origin.position.x, info.origin.position.y))
+        if amap.free_cell_count() == 0:
+            rospy.logerr('amcl: the map has no free cells; ignored')
+            return False
+        with self.lock:
+            self.pf.set_map(amap)
+            self.map_received = True
+            # A new map: start again from the current estimate, else from the initial pose parameters.
+            mean = self.last_estimate or self.s['initial_pose']
+            self.pf.init_gaussian(np.array(mean), np.diag(self.s['initial_cov']))
+            self.pf_odom_pose = None
+        rospy.loginfo('amcl: received a %d x %d map @ %.3f m/cell; %d particles around (%.2f, %.2f, %.2f)',
+                      info.width, info.height, info.resolution, self.params.max_particles, *mean)
+        return True
+
+    # ----------------------------------------------------------------------------------- services
+    def global_localization(self, _req):
+        with self.lock:
+            if not self.map_received:
+                rospy.logwarn('amcl: global_localization before a map arrived; nothing done')
+                return EmptyResponse()
+            self.pf.init_uniform()
+            self.pf_odom_pose = None
+        rospy.loginfo('amcl: global localization: %d particles spread over the free space', self.params.max_particles)
+        return EmptyResponse()
+
+    def nomotion_update(self, _req):
+        with self.lock:
+            self.force_update = True
+        rospy.loginfo('amcl: the next scan will update the filter without motion')
+        return EmptyResponse()
+
+    def set_map(self, req):
+        ok = self.handle_map(req.map)
+        if ok:
+            self.set_pose(req.initial_pose)
+        return SetMapResponse(success=ok)
+
+    # -------------------------------------------------------------------------------- initial pose
+    def initial_pose(self, msg: PoseWithCovarianceStamped):
+        frame = msg.header.frame_id.lstrip('/')
+        if not frame:
+            rospy.logwarn('amcl: initial pose with an empty frame_id; taking it in %s', self.s['global_frame_id'])
+        elif frame != self.s['global_frame_id']:
+            rospy.logwarn('amcl: ignoring the initial pose in frame "%s"; initial poses must be in the global frame "%s"',
+                          frame, self.s['global_frame_id'])
+            return
+        self.set_pose(msg)
+
+    def set_pose(self, msg: PoseWithCovarianceStamped):
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        values = (p.x, p.y, q.x, q.y, q.z, q.w)
+        norm = math.sqrt(q.x ** 2 + q.y ** 2 + q.z ** 2 + q.w ** 2)
+        if not all(math.isfinite(v) for v in values) or norm < 1e-6:
+            rospy.logerr('amcl: ignoring an initial pose with NaN, infinite or zero-length values: %s', values)
+            return
+        yaw = quaternion_to_yaw(q.x / norm, q.y / norm, q.z / norm, q.w / norm)
+        c = msg.pose.covariance
+        cov = np.array([[c[0], c[1], 0.0], [c[6], c[7], 0.0], [0.0, 0.0, c[35]]])
+        with self.lock:
+            if not self.map_received:
+                self.s['initial_pose'] = (p.x, p.y, yaw)
+                self.s['initial_cov'] = (c[0], c[7], c[35])
+                rospy.loginfo('amcl: initial pose (%.2f, %.2f, %.2f) kept until a map arrives', p.x, p.y, yaw)
+                return
+            self.pf.init_gaussian(np.array([p.x, p.y, yaw]), cov)
+            self.pf_odom_pose = None
+        rospy.loginfo('amcl: initial pose set to (%.3f, %.3f, %.3f)', p.x, p.y, yaw)
+
+    # ------------------------------------------------------------------------------- tf watchdog
+    def watch_tf(self, msg: TFMessage):
+        if not self.s['tf_broadcast']:
+            return
+        caller = msg._connection_header.get('callerid', '?') if hasattr(msg, '_connection_header') else '?'
+        if caller == rospy.get_name():
+            return
+        for t in msg.transforms:
+            if (t.header.frame_id.lstrip('/') == self.s['global_frame_id']
+                    and t.child_frame_id.lstrip('/') == self.s['odom_frame_id']):
+                if caller not in self.other_tf_publishers:
+                    self.other_tf_publishers.add(caller)
+                rospy.logerr_throttle(
+                    THROTTLE, 'amcl: %s also publishes %s -> %s (SLAM running?). Two publishers of one transform make '
+                              'the robot jump between their estimates: set ~tf_broadcast false on amcl, or do not '
+                              'start amcl while SLAM owns the transform' % (caller, self.s['global_frame_id'],
+                                                                           self.s['odom_frame_id']))
+
+    # -------------------------------------------------------------------------------------- scans
+    def laser_geometry(self, scan: LaserScan):
+        """The laser's position in the base frame and its beam angles there (handles lasers mounted
+        rotated or upside down, as ROS amcl does by transforming two beam directions)."""
+        frame = scan.header.frame_id
+        cached = self.laser_cache.get(frame)
+        if cached is None:
+            try:
+                t = self.tf.lookup_transform(self.s['base_frame_id'], frame, rospy.Time(0), rospy.Duration(0.5))
+            except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as e:
+                rospy.logwarn_throttle(THROTTLE, 'amcl: no transform from the laser frame "%s" to %s (%s); scan '
+                                                 'skipped' % (frame, self.s['base_frame_id'], e))
+                return None
+            q = t.transform.rotation
+            x, y, z, w = q.x, q.y, q.z, q.w
+            rot = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+            cached = (t.transform.translation.x, t.transform.translation.y, rot)
+            self.laser_cache[frame] = cached
+        x, y, rot = cached
+        d0 = rot @ [math.cos(scan.angle_min), math.sin(scan.angle_min), 0.0]
+        a1 = scan.angle_min + scan.angle_increment
+        d1 = rot @ [math.cos(a1), math.sin(a1), 0.0]
+        angle_min = math.atan2(d0[1], d0[0])
+        increment = normalize_angle(math.atan2(d1[1], d1[0]) - angle_min)
+        return (x, y), angle_min, increment
+
+    def odom_pose(self, stamp) -> Optional[Tuple[float, float, float]]:
+        try:
+            t = self.tf.lookup_transform(self.s['odom_frame_id'], self.s['base_frame_id'], stamp, rospy.Duration(0.1))
+        except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as e:
+            rospy.logwarn_throttle(THROTTLE, 'amcl: cannot find %s in %s at the scan time (%s); scan skipped'
+                                   % (self.s['base_frame_id'], self.s['odom_frame_id'], e))
+            return None
+        q = t.transform.rotation
+        return t.transform.translation.x, t.transform.translation.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
+
+    def scan_received(self, scan: LaserScan):
+        if not self.map_received:
+            return
+        if not scan.ranges or not (scan.range_max > 0) or not math.isfinite(scan.angle_increment):
+            rospy.logwarn_throttle(THROTTLE, 'amcl: malformed scan in frame "%s" (%d ranges, range_max %g); skipped'
+                                   % (scan.header.frame_id, len(scan.ranges), scan.range_max))
+            return
+        geometry = self.laser_geometry(scan)
+        pose = self.odom_pose(scan.header.stamp)
+        if geometry is None or pose is None:
+            return
+        (lx, ly), angle_min, increment = geometry
+        range_min = max(scan.range_min, self.s['laser_min_range']) if self.s['laser_min_range'] > 0 else scan.range_min
+        range_max = min(scan.range_max, self.s['laser_max_range']) if self.s['laser_max_range'] > 0 else scan.range_max
+        with self.lock:
+            update = False
+            if self.pf_odom_pose is None:
+                update = True  # first scan after (re)initialization: weigh without motion
+            else:
+                dx, dy = pose[0] - self.pf_odom_pose[0], pose[1] - self.pf_odom_pose[1]
+                da = normalize_angle(pose[2] - self.pf_odom_pose[2])
+                update = (abs(dx) > self.s['update_min_d'] or abs(dy) > self.s['update_min_d']
+                          or abs(da) > self.s['update_min_a'] or self.force_update)
+                if update:
+                    self.pf.motion_update(np.array(self.pf_odom_pose), np.array(pose))
+            self.force_update = False
+            if update:
+                self.pf.sensor_update(angle_min, increment, range_min, range_max,
+                                      np.asarray(scan.ranges, dtype=np.float32), np.array([lx, ly, 0.0]))
+                self.pf_odom_pose = pose
+                self.resample_count += 1
+                if self.resample_count % self.s['resample_interval'] == 0:
+                    self.pf.resample()
+                self.publish_estimate(scan.header.stamp, pose)
+                self.publish_cloud(scan.header.stamp)
+            self.send_transform(scan.header.stamp)
+
+    # ------------------------------------------------------------------------------------ outputs
+    def publish_estimate(self, stamp, odom_pose):
+        mean, cov, _weight, _clusters = self.pf.estimate()
+        x, y, yaw = float(mean[0]), float(mean[1]), float(mean[2])
+        msg = PoseWithCovarianceStamped()
+        msg.header.frame_id = self.s['global_frame_id']
+        msg.header.stamp = stamp
+        msg.pose.pose = pose_msg(x, y, yaw)
+        c = [0.0] * 36
+        c[0], c[1], c[6], c[7], c[35] = cov[0, 0], cov[0, 1], cov[1, 0], cov[1, 1], cov[2, 2]
+        msg.pose.covariance = c
+        self.pose_pub.publish(msg)
+        self.last_estimate = (x, y, yaw)
+        # map -> odom = (map -> base) * (odom -> base)^-1
+        self.map_to_odom = compose2d((x, y, yaw), inverse2d(odom_pose))
+
+    def publish_cloud(self, stamp):
+        rate = self.s['gui_publish_rate']
+        if rate > 0 and (stamp - self.last_cloud_time).to_sec() < 1.0 / rate:
+            return
+        self.last_cloud_time = stamp
+        cloud = PoseArray()
+        cloud.header.frame_id = self.s['global_frame_id']
+        cloud.header.stamp = stamp
+        cloud.poses = [pose_msg(px, py, pa) for px, py, pa, _w in self.pf.particles()]
+        self.cloud_pub.publish(cloud)
+
+    def send_transform(self, stamp):
+        if self.map_to_odom is None or not self.s['tf_broadcast']:
+            return
+        t = TransformStamped()
+        t.header.frame_id = self.s['global_frame_id']
+        t.child_frame_id = self.s['odom_frame_id']
+        t.header.stamp = stamp + rospy.Duration(self.s['transform_tolerance'])
+        t.transform.translation.x, t.transform.translation.y = self.map_to_odom[:2]
+        q = t.transform.rotation
+        q.x, q.y, q.z, q.w = yaw_to_quaternion(self.map_to_odom[2])
+        self.tf_pub.sendTransform(t)
+
+    def save_pose(self, _event):
+        """As ROS amcl: the last estimate goes to ~initial_pose_* so a restart resumes from it."""
+        if self.last_estimate is None:
+            return
+        x, y, yaw = self.last_estimate
+        rospy.set_param('~initial_pose_x', x)
+        rospy.set_param('~initial_pose_y', y)
+        rospy.set_param('~initial_pose_a', yaw)
+
+
+def main() -> None:
+    rospy.init_node('amcl')
+    AmclNode()
+    rospy.spin()
