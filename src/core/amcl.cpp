@@ -273,24 +273,37 @@ int Amcl::sensorUpdate(const LaserScan& scan, const Eigen::Vector3d& laser_pose)
       field_map_ = map_.get();
       field_range_max_ = range_max;
     }
-    // Beam end points in the base frame, once per scan; max readings are skipped (ROS).
-    std::vector<Eigen::Vector2d> ends;
-    ends.reserve(beams.size());
+    // Beam end points in the base frame, in cells, once per scan; max readings are skipped (ROS).
+    // Structure of arrays and floats: the inner loop is two multiply-adds and one lookup per beam.
+    const double inv_res = 1.0 / map_->resolution();
+    std::vector<float> ex, ey;
+    ex.reserve(beams.size());
+    ey.reserve(beams.size());
     const double lc = std::cos(laser_pose.z()), ls = std::sin(laser_pose.z());
     for (const auto& b : beams) {
       if (b.range >= range_max) continue;
-      const double ex = b.range * std::cos(b.bearing), ey = b.range * std::sin(b.bearing);
-      ends.emplace_back(laser_pose.x() + lc * ex - ls * ey, laser_pose.y() + ls * ex + lc * ey);
+      const double bx = b.range * std::cos(b.bearing), by = b.range * std::sin(b.bearing);
+      ex.push_back(static_cast<float>((laser_pose.x() + lc * bx - ls * by) * inv_res));
+      ey.push_back(static_cast<float>((laser_pose.y() + ls * bx + lc * by) * inv_res));
     }
-    const double inv_res = 1.0 / map_->resolution(), ox = map_->origin().x(), oy = map_->origin().y();
     const int w = map_->width(), h = map_->height();
+    const std::size_t n = ex.size();
+    const float* field = field_.data();
+    const float outside = field_outside_;
     for (auto& p : particles_) {
-      const double c = std::cos(p.pose.z()), s = std::sin(p.pose.z());
+      const float c = static_cast<float>(std::cos(p.pose.z())), s = static_cast<float>(std::sin(p.pose.z()));
+      const float x0 = static_cast<float>((p.pose.x() - map_->origin().x()) * inv_res);
+      const float y0 = static_cast<float>((p.pose.y() - map_->origin().y()) * inv_res);
       double sum = 1.0;
-      for (const auto& e : ends) {
-        const int cx = static_cast<int>(std::floor((p.pose.x() + c * e.x() - s * e.y() - ox) * inv_res));
-        const int cy = static_cast<int>(std::floor((p.pose.y() + s * e.x() + c * e.y() - oy) * inv_res));
-        sum += (cx >= 0 && cy >= 0 && cx < w && cy < h) ? field_[static_cast<std::size_t>(cy) * w + cx] : field_outside_;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float fx = x0 + c * ex[i] - s * ey[i];
+        const float fy = y0 + s * ex[i] + c * ey[i];
+        // floor for negative values too (cells left of or below the map are outside)
+        const int cx = static_cast<int>(fx) - (fx < 0.0f);
+        const int cy = static_cast<int>(fy) - (fy < 0.0f);
+        sum += (static_cast<unsigned>(cx) < static_cast<unsigned>(w) && static_cast<unsigned>(cy) < static_cast<unsigned>(h))
+                   ? field[static_cast<std::size_t>(cy) * w + cx]
+                   : outside;
       }
       p.weight *= sum;
     }

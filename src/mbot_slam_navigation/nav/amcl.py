@@ -27,7 +27,8 @@ from tf2_msgs.msg import TFMessage
 
 from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
-from mbot_slam_navigation.transforms import compose2d, inverse2d, normalize_angle, quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.nav.localizer import Localizer
+from mbot_slam_navigation.transforms import normalize_angle, quaternion_to_yaw, yaw_to_quaternion
 
 ODOM_MODELS = {'diff': 'diff', 'diff-corrected': 'diff', 'omni': 'omni', 'omni-corrected': 'omni'}
 LASER_MODELS = {'likelihood_field': 'likelihood_field', 'likelihood_field_prob': 'likelihood_field', 'beam': 'beam'}
@@ -124,10 +125,8 @@ class AmclNode:
         r.report_unknown()
         self.lock = threading.RLock()
         self.pf = _core._Amcl(self.params, self.s['seed'])
+        self.loc = Localizer(self.pf, self.s['update_min_d'], self.s['update_min_a'], self.s['resample_interval'])
         self.map_received = False
-        self.pf_odom_pose: Optional[Tuple[float, float, float]] = None  # base in odom at the last filter update
-        self.force_update = False
-        self.resample_count = 0
         self.laser_cache = {}   # frame_id -> (x, y, angle_min, angle_increment, sign) in the base frame
         self.map_to_odom: Optional[Tuple[float, float, float]] = None
         self.last_estimate: Optional[Tuple[float, float, float]] = None
@@ -194,7 +193,7 @@ class AmclNode:
             # A new map: start again from the current estimate, else from the initial pose parameters.
             mean = self.last_estimate or self.s['initial_pose']
             self.pf.init_gaussian(np.array(mean), np.diag(self.s['initial_cov']))
-            self.pf_odom_pose = None
+            self.loc.reinitialized()
         rospy.loginfo('amcl: received a %d x %d map @ %.3f m/cell; %d particles around (%.2f, %.2f, %.2f)',
                       info.width, info.height, info.resolution, self.params.max_particles, *mean)
         return True
@@ -206,13 +205,13 @@ class AmclNode:
                 rospy.logwarn('amcl: global_localization before a map arrived; nothing done')
                 return EmptyResponse()
             self.pf.init_uniform()
-            self.pf_odom_pose = None
+            self.loc.reinitialized()
         rospy.loginfo('amcl: global localization: %d particles spread over the free space', self.params.max_particles)
         return EmptyResponse()
 
     def nomotion_update(self, _req):
         with self.lock:
-            self.force_update = True
+            self.loc.force_update = True
         rospy.loginfo('amcl: the next scan will update the filter without motion')
         return EmptyResponse()
 
@@ -250,7 +249,7 @@ class AmclNode:
                 rospy.loginfo('amcl: initial pose (%.2f, %.2f, %.2f) kept until a map arrives', p.x, p.y, yaw)
                 return
             self.pf.init_gaussian(np.array([p.x, p.y, yaw]), cov)
-            self.pf_odom_pose = None
+            self.loc.reinitialized()
         rospy.loginfo('amcl: initial pose set to (%.3f, %.3f, %.3f)', p.x, p.y, yaw)
 
     # ------------------------------------------------------------------------------- tf watchdog
@@ -324,32 +323,14 @@ class AmclNode:
         range_min = max(scan.range_min, self.s['laser_min_range']) if self.s['laser_min_range'] > 0 else scan.range_min
         range_max = min(scan.range_max, self.s['laser_max_range']) if self.s['laser_max_range'] > 0 else scan.range_max
         with self.lock:
-            update = False
-            if self.pf_odom_pose is None:
-                update = True  # first scan after (re)initialization: weigh without motion
-            else:
-                dx, dy = pose[0] - self.pf_odom_pose[0], pose[1] - self.pf_odom_pose[1]
-                da = normalize_angle(pose[2] - self.pf_odom_pose[2])
-                update = (abs(dx) > self.s['update_min_d'] or abs(dy) > self.s['update_min_d']
-                          or abs(da) > self.s['update_min_a'] or self.force_update)
-                if update:
-                    self.pf.motion_update(np.array(self.pf_odom_pose), np.array(pose))
-            self.force_update = False
-            if update:
-                self.pf.sensor_update(angle_min, increment, range_min, range_max,
-                                      np.asarray(scan.ranges, dtype=np.float32), np.array([lx, ly, 0.0]))
-                self.pf_odom_pose = pose
-                self.resample_count += 1
-                if self.resample_count % self.s['resample_interval'] == 0:
-                    self.pf.resample()
-                self.publish_estimate(scan.header.stamp, pose)
+            if self.loc.update(pose, angle_min, increment, range_min, range_max, scan.ranges, (lx, ly)):
+                self.publish_estimate(scan.header.stamp)
                 self.publish_cloud(scan.header.stamp)
             self.send_transform(scan.header.stamp)
 
     # ------------------------------------------------------------------------------------ outputs
-    def publish_estimate(self, stamp, odom_pose):
-        mean, cov, _weight, _clusters = self.pf.estimate()
-        x, y, yaw = float(mean[0]), float(mean[1]), float(mean[2])
+    def publish_estimate(self, stamp):
+        (x, y, yaw), cov, _weight, _clusters = self.loc.estimate()
         msg = PoseWithCovarianceStamped()
         msg.header.frame_id = self.s['global_frame_id']
         msg.header.stamp = stamp
@@ -359,8 +340,7 @@ class AmclNode:
         msg.pose.covariance = c
         self.pose_pub.publish(msg)
         self.last_estimate = (x, y, yaw)
-        # map -> odom = (map -> base) * (odom -> base)^-1
-        self.map_to_odom = compose2d((x, y, yaw), inverse2d(odom_pose))
+        self.map_to_odom = self.loc.map_to_odom(self.last_estimate)
 
     def publish_cloud(self, stamp):
         rate = self.s['gui_publish_rate']
