@@ -1,0 +1,96 @@
+"""amcl's parameters and update rule, ROS-free: launch/amcl_diff.launch as the node reads it, bad
+values naming their key, and when the filter updates (the Localizer shared by node and bench)."""
+import math
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+import yaml
+
+from mbot_slam_navigation import _core
+from mbot_slam_navigation.nav.amcl import read_parameters
+from mbot_slam_navigation.nav.localizer import Localizer
+from mbot_slam_navigation.nav.params import ParamError, ParamReader
+
+LAUNCH = os.path.join(os.path.dirname(__file__), '..', '..', 'launch', 'amcl_diff.launch')
+
+
+def launch_values():
+    return {p.get('name'): yaml.safe_load(p.get('value')) for p in ET.parse(LAUNCH).getroot().iter('param')}
+
+
+def test_amcl_diff_launch_reads_without_warnings_and_keeps_the_example_values():
+    warnings = []
+    r = ParamReader(launch_values(), '/amcl', warnings.append)
+    p, s = read_parameters(r)
+    assert r.report_unknown() == [] and warnings == []
+    assert (p.min_particles, p.max_particles, p.kld_err, p.max_beams) == (500, 5000, 0.05, 30)
+    assert (p.z_hit, p.z_rand, p.sigma_hit, p.laser_model, p.odom_model) == (0.5, 0.5, 0.2, 'likelihood_field', 'diff')
+    assert s['transform_tolerance'] == 0.1  # the second of the two lines wins, as in roslaunch
+    assert (s['update_min_d'], s['update_min_a'], s['resample_interval']) == (0.2, 0.5, 1)
+    # The alphas are the example's converted to the corrected model at one update step.
+    assert p.alpha3 == pytest.approx((0.8 * 0.2) ** 2) and p.alpha1 == pytest.approx((0.2 * 0.5) ** 2)
+    assert s['base_frame_id'] == 'base_link' and s['global_frame_id'] == 'map' and s['tf_broadcast'] is True
+
+
+def test_ros_defaults_when_nothing_is_set():
+    p, s = read_parameters(ParamReader({}, '/amcl', print))
+    assert (p.min_particles, p.max_particles, p.kld_err, p.kld_z) == (100, 5000, 0.01, 0.99)
+    assert (p.z_hit, p.z_short, p.z_max, p.z_rand, p.sigma_hit) == (0.95, 0.1, 0.05, 0.05, 0.2)
+    assert s['update_min_a'] == pytest.approx(math.pi / 6) and s['resample_interval'] == 2
+    assert s['initial_cov'] == pytest.approx((0.25, 0.25, (math.pi / 12) ** 2))
+
+
+@pytest.mark.parametrize('values, words', [
+    ({'max_particles': 50, 'min_particles': 100}, '/amcl/max_particles'),
+    ({'odom_model_type': 'diff-drive'}, '/amcl/odom_model_type'),
+    ({'laser_model_type': 'beams'}, '/amcl/laser_model_type'),
+    ({'laser_sigma_hit': 0}, '/amcl/laser_sigma_hit'),
+    ({'kld_err': 'small'}, '/amcl/kld_err'),
+    ({'laser_max_beams': 1}, '/amcl/laser_max_beams'),
+])
+def test_bad_values_name_the_key(values, words):
+    with pytest.raises(ParamError, match=words):
+        read_parameters(ParamReader(values, '/amcl', print))
+
+
+def test_misspelt_key_gets_the_nearest_name_and_frames_lose_a_leading_slash():
+    warnings = []
+    r = ParamReader({'odom_alpha_1': 0.1, 'base_frame_id': '/base_footprint'}, '/amcl', warnings.append)
+    _, s = read_parameters(r)
+    r.report_unknown()
+    assert s['base_frame_id'] == 'base_footprint'
+    assert any('odom_alpha_1' in w and 'odom_alpha1' in w for w in warnings), warnings
+
+
+def test_localizer_updates_on_motion_thresholds_and_resamples_every_interval():
+    data = np.zeros((60, 60), np.int8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100
+    p = _core._AmclParams()
+    p.min_particles = p.max_particles = 200
+    pf = _core._Amcl(p, 1)
+    pf.set_map(_core._AmclMap(data, 0.1, (0.0, 0.0)))
+    pf.init_gaussian(np.array([3.0, 3.0, 0.0]), np.diag([0.01, 0.01, 0.01]))
+    loc = Localizer(pf, update_min_d=0.2, update_min_a=0.5, resample_interval=2)
+    ranges = np.full(90, 2.9, np.float32)
+    args = (-math.pi, 2 * math.pi / 90, 0.1, 8.0, ranges, (0.0, 0.0))
+    assert loc.update((0.0, 0.0, 0.0), *args)            # first scan: always
+    assert not loc.update((0.15, 0.1, 0.3), *args)       # below every threshold
+    assert loc.update((0.25, 0.0, 0.0), *args)           # x moved 0.25 > 0.2
+    assert not loc.update((0.3, 0.1, 0.4), *args)
+    assert loc.update((0.3, 0.1, 0.8), *args)            # turned 0.8 > 0.5
+    loc.force_update = True                               # request_nomotion_update
+    assert loc.update((0.3, 0.1, 0.8), *args) and not loc.force_update
+    assert loc.updates == 4
+    mo = loc.map_to_odom(loc.estimate()[0])
+    assert len(mo) == 3
+
+
+def test_launch_file_names_are_unique_so_roslaunch_by_name_works():
+    # `roslaunch mbot_slam_navigation move_base.launch` (the tutorial's command) fails when two files
+    # in the package share the name.
+    root = os.path.join(os.path.dirname(__file__), '..', '..')
+    names = [f for d, _, files in os.walk(os.path.join(root, 'launch')) for f in files if f.endswith('.launch')]
+    assert len(names) == len(set(names)), sorted(names)
+    assert 'move_base.launch' in names and 'myrobot_world.launch' in names and 'amcl_diff.launch' in names
