@@ -344,7 +344,8 @@ class AmclNode:
 
     def publish_cloud(self, stamp):
         rate = self.s['gui_publish_rate']
-        if rate > 0 and (stamp - self.last_cloud_time).to_sec() < 1.0 / rate:
+        since = (stamp - self.last_cloud_time).to_sec()
+        if rate > 0 and 0.0 <= since < 1.0 / rate:  # (negative: simulated time was reset)
             return
         self.last_cloud_time = stamp
         cloud = PoseArray()
