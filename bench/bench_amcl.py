@@ -32,7 +32,6 @@ from mbot_slam_navigation.sim.ground_truth import rasterize
 from mbot_slam_navigation.sim.sdf_world import load_world
 from mbot_slam_navigation.sim.simulation import Simulation
 from mbot_slam_navigation.sim.urdf_robot import parse_urdf
-from mbot_slam_navigation.transforms import compose2d
 
 PKG = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(PKG, 'bench', 'out')

@@ -1,6 +1,5 @@
 """map_server's YAML rules, map_saver's output and compare_maps, on files in a temporary folder."""
 import math
-import os
 
 import cv2
 import numpy as np
@@ -51,8 +50,10 @@ def test_save_then_load_gives_the_same_grid_and_pose(tmp_path):
     assert meta['image'] == 'home.pgm'  # relative, so the pair can be moved together
     img = cv2.imread(str(tmp_path / 'home.pgm'), cv2.IMREAD_UNCHANGED)
     assert set(np.unique(img)) == {0, 205, 254}
-    assert img[0, 0] == 205 if data[-1, 0] == -1 else True  # top image row = highest map row
-    assert img[-1, 0] == 205  # the unknown corner is at the lowest rows
+    # The image's top row is the map's highest row: walls and the unknown corner land flipped.
+    np.testing.assert_array_equal(img[::-1] == 0, data == 100)
+    np.testing.assert_array_equal(img[::-1] == 205, data == -1)
+    assert img[-1, 5] == 205 and img[0, 5] == 0
 
 
 def test_saver_thresholds_decide_cells_between_them(tmp_path):

@@ -4,7 +4,8 @@ Interface as ROS's amcl: subscribes `scan`, `initialpose` (rviz's 2D Pose Estima
 use_map_topic, otherwise the map comes once from the `static_map` service); publishes `amcl_pose`
 (latched), `particlecloud` (latched) and map -> odom on tf (future-dated by transform_tolerance,
 unless tf_broadcast is false); serves `global_localization`, `request_nomotion_update` and
-`set_map`. Parameters: ROS amcl's names and defaults (parameters_of()).
+`set_map`. Parameters: ROS amcl's names and defaults (read_parameters()), plus ~seed (0) for the
+random generator.
 
 Differences from ROS, on purpose: "diff" and "omni" are the corrected odometry models (ROS's
 "-corrected" ones: sqrt(alpha * motion^2) is the standard deviation); yaw bins wrap when clusters are
@@ -127,11 +128,10 @@ class AmclNode:
         self.pf = _core._Amcl(self.params, self.s['seed'])
         self.loc = Localizer(self.pf, self.s['update_min_d'], self.s['update_min_a'], self.s['resample_interval'])
         self.map_received = False
-        self.laser_cache = {}   # frame_id -> (x, y, angle_min, angle_increment, sign) in the base frame
+        self.laser_cache = {}   # frame_id -> (x [m], y [m], 3x3 rotation) of the laser in the base frame
         self.map_to_odom: Optional[Tuple[float, float, float]] = None
         self.last_estimate: Optional[Tuple[float, float, float]] = None
         self.last_cloud_time = rospy.Time(0)
-        self.other_tf_publishers = set()
 
         self.tf = tf2_ros.Buffer(rospy.Duration(30.0))
         self.tf_listener = tf2_ros.TransformListener(self.tf)
@@ -262,8 +262,6 @@ class AmclNode:
         for t in msg.transforms:
             if (t.header.frame_id.lstrip('/') == self.s['global_frame_id']
                     and t.child_frame_id.lstrip('/') == self.s['odom_frame_id']):
-                if caller not in self.other_tf_publishers:
-                    self.other_tf_publishers.add(caller)
                 rospy.logerr_throttle(
                     THROTTLE, 'amcl: %s also publishes %s -> %s (SLAM running?). Two publishers of one transform make '
                               'the robot jump between their estimates: set ~tf_broadcast false on amcl, or do not '
