@@ -14,14 +14,9 @@ from rosgraph_msgs.msg import Log
 from std_srvs.srv import Empty
 
 from mbot_slam_navigation.route_driver import HOME_TOUR, RouteDriver
-from mbot_slam_navigation.transforms import quaternion_to_yaw
+from mbot_slam_navigation.ros_msgs import pose_from_msg
 
 CONVERGED = 0.2  # [m]
-
-
-def pose_of(msg):
-    p, q = msg.pose.pose.position, msg.pose.pose.orientation
-    return p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
 
 
 class AmclGlobalHomeTest(unittest.TestCase):
@@ -41,7 +36,7 @@ class AmclGlobalHomeTest(unittest.TestCase):
     @classmethod
     def on_truth(cls, msg):
         with cls.lock:
-            p = pose_of(msg)
+            p = pose_from_msg(msg.pose.pose)
             if cls.truth is not None:
                 cls.distance += math.hypot(p[0] - cls.truth[0], p[1] - cls.truth[1])
             cls.truth = p
@@ -50,7 +45,7 @@ class AmclGlobalHomeTest(unittest.TestCase):
     def on_estimate(cls, msg):
         with cls.lock:
             if cls.truth is not None:
-                cls.estimates.append((msg.header.stamp.to_sec(), pose_of(msg), cls.truth, cls.distance))
+                cls.estimates.append((msg.header.stamp.to_sec(), pose_from_msg(msg.pose.pose), cls.truth, cls.distance))
 
     def test_1_global_localization_converges_while_driving(self):
         rospy.wait_for_service('/global_localization', timeout=30.0)

@@ -17,18 +17,14 @@ from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import Odometry
 
 from mbot_slam_navigation.msg import Contact
-from mbot_slam_navigation.transforms import normalize_angle, quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.ros_msgs import pose_from_msg
+from mbot_slam_navigation.transforms import normalize_angle, yaw_to_quaternion
 
 # wall.world: three rooms side by side; the left and middle ones join at the top, the middle and
 # right ones at the bottom. The car starts at the origin, in the middle room, facing +x.
 GOALS = [(0.0, 3.4, math.pi / 2), (-3.2, -3.0, -math.pi / 2), (0.0, -3.4, 0.0)]
 TRACK_TOL = 0.15   # [m] amcl's estimate against ground truth, all along the way
 WRONG_START = (0.7, 0.5, 0.3)  # the initial pose a user gets wrong: 0.86 m and 0.3 rad off
-
-
-def pose_of(msg):
-    p, q = msg.pose.pose.position, msg.pose.pose.orientation
-    return p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
 
 
 class CarNavigationTest(unittest.TestCase):
@@ -50,12 +46,12 @@ class CarNavigationTest(unittest.TestCase):
     def on_truth(cls, msg):
         with cls.lock:
             cls.truth_t.append(msg.header.stamp.to_sec())
-            cls.truth.append(pose_of(msg))
+            cls.truth.append(pose_from_msg(msg.pose.pose))
 
     @classmethod
     def on_estimate(cls, msg):
         with cls.lock:
-            cls.estimates.append((msg.header.stamp.to_sec(), pose_of(msg)))
+            cls.estimates.append((msg.header.stamp.to_sec(), pose_from_msg(msg.pose.pose)))
 
     def truth_at(self, t):
         with self.lock:

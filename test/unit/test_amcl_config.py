@@ -12,6 +12,7 @@ from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.amcl import read_parameters
 from mbot_slam_navigation.nav.localizer import Localizer
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
+from mbot_slam_navigation.transforms import compose2d
 
 LAUNCH = os.path.join(os.path.dirname(__file__), '..', '..', 'launch', 'amcl_diff.launch')
 
@@ -83,8 +84,10 @@ def test_localizer_updates_on_motion_thresholds_and_resamples_every_interval():
     loc.force_update = True                               # request_nomotion_update
     assert loc.update((0.3, 0.1, 0.8), *args) and not loc.force_update
     assert loc.updates == 4
-    mo = loc.map_to_odom(loc.estimate()[0])
-    assert len(mo) == 3
+    # map -> odom composed with the odometry pose of the last update gives the estimate back.
+    est = loc.estimate()[0]
+    back = compose2d(loc.map_to_odom(est), (0.3, 0.1, 0.8))
+    assert back == pytest.approx(est)
 
 
 def test_launch_file_names_are_unique_so_roslaunch_by_name_works():

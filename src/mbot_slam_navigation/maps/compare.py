@@ -12,9 +12,7 @@ from typing import Tuple
 import cv2
 import numpy as np
 
-from mbot_slam_navigation.maps.map_io import LoadedMap
-
-OCCUPIED_MIN, FREE_MAX = 65, 25
+from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, LoadedMap
 
 
 @dataclass
@@ -84,7 +82,7 @@ class _Canvas:
 
 def _classes(m: LoadedMap):
     d = m.data.astype(np.int16)
-    return d >= OCCUPIED_MIN, (d >= 0) & (d <= FREE_MAX)
+    return d >= SAVER_OCCUPIED, (d >= 0) & (d <= SAVER_FREE)
 
 
 def compare_maps(a: LoadedMap, b: LoadedMap, tolerance: float = 0.1, max_rotation_deg: float = 180.0,

@@ -15,6 +15,8 @@ import numpy as np
 import yaml
 
 FREE, OCCUPIED, UNKNOWN = 254, 0, 205
+# map_saver's default thresholds, occupancy values: >= 65 saved occupied, 0..25 free.
+SAVER_OCCUPIED, SAVER_FREE = 65, 25
 
 
 def _atomic_write(path: str, data: bytes) -> None:

@@ -18,23 +18,8 @@ import rospy
 from nav_msgs.msg import MapMetaData, OccupancyGrid
 from nav_msgs.srv import GetMap, GetMapResponse, LoadMap, LoadMapResponse
 
-from mbot_slam_navigation.maps.map_io import MapFileError, load_map, save_map
-from mbot_slam_navigation.transforms import quaternion_to_yaw, yaw_to_quaternion
-
-
-def to_msg(loaded, frame_id: str, stamp) -> OccupancyGrid:
-    msg = OccupancyGrid()
-    msg.header.frame_id = frame_id
-    msg.header.stamp = stamp
-    msg.info.map_load_time = stamp
-    msg.info.resolution = loaded.resolution
-    msg.info.height, msg.info.width = loaded.data.shape
-    msg.info.origin.position.x, msg.info.origin.position.y = loaded.origin[:2]
-    q = yaw_to_quaternion(loaded.origin[2])
-    o = msg.info.origin.orientation
-    o.x, o.y, o.z, o.w = q
-    msg.data = loaded.data.ravel().tolist()
-    return msg
+from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, MapFileError, load_map, save_map
+from mbot_slam_navigation.ros_msgs import occupancy_grid_msg, pose_from_msg
 
 
 class MapServer:
@@ -48,7 +33,7 @@ class MapServer:
         rospy.Service('change_map', LoadMap, self._change_map)
 
     def _publish(self, loaded, path):
-        self.msg = to_msg(loaded, self.frame_id, rospy.Time.now())
+        self.msg = occupancy_grid_msg(loaded.data, loaded.resolution, loaded.origin, self.frame_id, rospy.Time.now())
         self.meta_pub.publish(self.msg.info)
         self.map_pub.publish(self.msg)
         rospy.loginfo('map_server: read a %d x %d map @ %.3f m/cell from %s', self.msg.info.width,
@@ -91,9 +76,7 @@ def write_map(msg: OccupancyGrid, basename: str, occupied: int, free: int) -> No
     """map_saver's output for `msg`: thresholds are occupancy values 0..100."""
     info = msg.info
     data = np.asarray(msg.data, dtype=np.int8).reshape(info.height, info.width)
-    o = info.origin.orientation
-    save_map(basename, data, info.resolution,
-             (info.origin.position.x, info.origin.position.y, quaternion_to_yaw(o.x, o.y, o.z, o.w)),
+    save_map(basename, data, info.resolution, pose_from_msg(info.origin),
              occupied_thresh=occupied / 100.0, free_thresh=free / 100.0)
 
 
@@ -102,8 +85,8 @@ def map_saver_main(argv=None):
         prog='map_saver', description='Saves the map published on "map" as NAME.pgm and NAME.yaml '
                                       '(map:=TOPIC or _map:=TOPIC reads another topic).')
     parser.add_argument('-f', dest='name', default='map', help='output name without extension (default: map)')
-    parser.add_argument('--occ', type=int, default=65, help='occupied threshold, 0..100 (default 65)')
-    parser.add_argument('--free', type=int, default=25, help='free threshold, 0..100 (default 25)')
+    parser.add_argument('--occ', type=int, default=SAVER_OCCUPIED, help='occupied threshold, 0..100 (default %(default)s)')
+    parser.add_argument('--free', type=int, default=SAVER_FREE, help='free threshold, 0..100 (default %(default)s)')
     parser.add_argument('--timeout', type=float, default=30.0,
                         help='seconds (wall clock) to wait for a map before giving up (default 30)')
     args = parser.parse_args(rospy.myargv(argv if argv is not None else sys.argv)[1:])

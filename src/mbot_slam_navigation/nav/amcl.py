@@ -19,7 +19,7 @@ from typing import Optional, Tuple
 import numpy as np
 import rospy
 import tf2_ros
-from geometry_msgs.msg import Pose, PoseArray, PoseWithCovarianceStamped, TransformStamped
+from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped, TransformStamped
 from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import GetMap, SetMap, SetMapResponse
 from sensor_msgs.msg import LaserScan
@@ -29,6 +29,7 @@ from tf2_msgs.msg import TFMessage
 from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
 from mbot_slam_navigation.nav.localizer import Localizer
+from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.transforms import normalize_angle, quaternion_to_yaw, yaw_to_quaternion
 
 ODOM_MODELS = {'diff': 'diff', 'diff-corrected': 'diff', 'omni': 'omni', 'omni-corrected': 'omni'}
@@ -105,14 +106,6 @@ def read_parameters(r: ParamReader):
             r.raw(key)
             r.warn('parameter %s is not implemented here and is ignored' % r.where(key))
     return p, s
-
-
-def pose_msg(x: float, y: float, yaw: float) -> Pose:
-    pose = Pose()
-    pose.position.x, pose.position.y = x, y
-    q = pose.orientation
-    q.x, q.y, q.z, q.w = yaw_to_quaternion(yaw)
-    return pose
 
 
 class AmclNode:

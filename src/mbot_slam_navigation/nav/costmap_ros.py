@@ -18,6 +18,7 @@ from nav_msgs.msg import OccupancyGrid
 from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.nav.costmap import CostmapConfig, LayeredCostmap
+from mbot_slam_navigation.ros_msgs import occupancy_grid_msg
 from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
@@ -155,15 +156,7 @@ class CostmapROS:
         h, w = geometry[0]
         # The full grid every time (so a latecomer to the latched topic sees a current one), and the
         # same as an update message for clients that follow costmap_updates like rviz does.
-        msg = OccupancyGrid()
-        msg.header.stamp = stamp
-        msg.header.frame_id = self.config.global_frame
-        msg.info.map_load_time = stamp
-        msg.info.resolution = geometry[2]
-        msg.info.width, msg.info.height = w, h
-        msg.info.origin.position.x, msg.info.origin.position.y = geometry[1]
-        msg.info.origin.orientation.w = 1.0
-        msg.data = data.ravel().tolist()  # int8[]: rospy packs a sequence of ints
+        msg = occupancy_grid_msg(data.reshape(h, w), geometry[2], geometry[1], self.config.global_frame, stamp)
         self.costmap_pub.publish(msg)
         if self.updates_pub.get_num_connections() > 0:
             up = OccupancyGridUpdate()

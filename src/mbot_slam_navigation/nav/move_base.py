@@ -30,7 +30,8 @@ from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.costmap_ros import CostmapROS
 from mbot_slam_navigation.nav.params import ParamError, ParamReader, nearest_key
 from mbot_slam_navigation.nav.trajectory_planner import TrajectoryController, local_planner_params
-from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw, yaw_to_quaternion
+from mbot_slam_navigation.ros_msgs import pose_msg
+from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw
 
 PLANNING, CONTROLLING, CLEARING = 'planning', 'controlling', 'clearing'
 GLOBAL_PLANNERS = {'navfn/NavfnROS': 'NavfnROS', 'global_planner/GlobalPlanner': 'GlobalPlanner'}
@@ -60,12 +61,7 @@ def check_quaternion(q) -> Tuple[Optional[float], str]:
 
 def pose_stamped(header, x: float, y: float, yaw: float) -> PoseStamped:
     """A planar pose as geometry_msgs/PoseStamped (``header`` is copied)."""
-    ps = PoseStamped()
-    ps.header = header
-    ps.pose.position.x, ps.pose.position.y = float(x), float(y)
-    o = ps.pose.orientation
-    o.x, o.y, o.z, o.w = yaw_to_quaternion(yaw)
-    return ps
+    return PoseStamped(header=header, pose=pose_msg(x, y, yaw))
 
 
 class MoveBase:

@@ -18,7 +18,7 @@ import time
 import warnings
 
 import rospy
-from geometry_msgs.msg import Pose, Pose2D, TransformStamped, Twist
+from geometry_msgs.msg import Pose2D, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
@@ -26,6 +26,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import World, load_world
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
 from mbot_slam_navigation.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
@@ -53,13 +54,6 @@ def _prefixed(namespace: str, frame: str) -> str:
     """gazebo_ros's tf_prefix rule: frames of a namespaced robot are '<ns>/<frame>'."""
     ns = namespace.strip('/')
     return '%s/%s' % (ns, frame) if ns else frame
-
-
-def _pose_msg(x, y, yaw) -> Pose:
-    p = Pose()
-    p.position.x, p.position.y = x, y
-    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = yaw_to_quaternion(yaw)
-    return p
 
 
 class RobotIO:
@@ -190,7 +184,7 @@ class SimNode:
         except SimulationError as e:
             res.success, res.status_message = False, 'GetModelState: %s' % e
             return res
-        res.pose = _pose_msg(*pose)
+        res.pose = pose_msg(*pose)
         res.twist.linear.x, res.twist.linear.y = v * math.cos(robot.pose[2]), v * math.sin(robot.pose[2])
         res.twist.angular.z = w
         res.success, res.status_message = True, 'GetModelState: got properties'
@@ -233,7 +227,7 @@ class SimNode:
             v, w = robot.drive.linear_velocity, robot.drive.angular_velocity
             odom = Odometry()
             odom.header.stamp, odom.header.frame_id, odom.child_frame_id = stamp, io.odom_frame, io.base_frame
-            odom.pose.pose = _pose_msg(ox, oy, oyaw)
+            odom.pose.pose = pose_msg(ox, oy, oyaw)
             cx, cy, cyaw = robot.spec.drive.covariance
             odom.pose.covariance[0], odom.pose.covariance[7], odom.pose.covariance[35] = cx, cy, cyaw
             odom.twist.twist.linear.x, odom.twist.twist.angular.z = v, w
@@ -241,7 +235,7 @@ class SimNode:
             if io.truth_pub.get_num_connections() > 0:  # building it costs; evaluation tools subscribe
                 truth = Odometry()
                 truth.header.stamp, truth.header.frame_id, truth.child_frame_id = stamp, 'world', io.base_frame
-                truth.pose.pose = _pose_msg(*robot.pose)
+                truth.pose.pose = pose_msg(*robot.pose)
                 truth.twist.twist.linear.x, truth.twist.twist.angular.z = v, w
                 io.truth_pub.publish(truth)
             transforms = []
