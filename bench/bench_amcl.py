@@ -25,6 +25,7 @@ import cv2
 import numpy as np
 
 from mbot_slam_navigation import _core
+from mbot_slam_navigation.launch_files import node_params
 from mbot_slam_navigation.maps.map_io import load_map
 from mbot_slam_navigation.nav.localizer import Localizer
 from mbot_slam_navigation.route_driver import HOME_TOUR, RouteDriver
@@ -38,18 +39,11 @@ OUT = os.path.join(PKG, 'bench', 'out')
 ROS_EXAMPLE_ALPHAS = dict(alpha1=0.2, alpha2=0.2, alpha3=0.8, alpha4=0.2)  # amcl_diff.launch in ROS, verbatim
 
 
-def launch_params(path):
-    """The <param> values of a launch file's node, as rosparam would type them."""
-    import xml.etree.ElementTree as ET
-    import yaml
-    return {p.get('name'): yaml.safe_load(p.get('value')) for p in ET.parse(path).getroot().iter('param')}
-
-
 def amcl_diff():
     """(core params, node settings) exactly as the amcl node reads launch/amcl_diff.launch."""
     from mbot_slam_navigation.nav.amcl import read_parameters
     from mbot_slam_navigation.nav.params import ParamReader
-    r = ParamReader(launch_params(os.path.join(PKG, 'launch', 'amcl_diff.launch')), '/amcl', print)
+    r = ParamReader(node_params(os.path.join(PKG, 'launch', 'amcl_diff.launch'), '/amcl'), '/amcl', print)
     return read_parameters(r)
 
 

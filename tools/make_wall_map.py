@@ -9,9 +9,10 @@ import subprocess
 import sys
 import time
 
-import actionlib
 import rospy
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+
+from mbot_slam_navigation.nav.action_client import SimpleActionClient
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 # wall.world (map = world frame, the car starts at the origin): the middle room, the left room
@@ -27,7 +28,7 @@ def main():
     try:
         time.sleep(5.0)
         rospy.init_node('make_wall_map')
-        client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+        client = SimpleActionClient('move_base', MoveBaseAction)
         if not client.wait_for_server(rospy.Duration(60.0)):
             raise SystemExit('move_base did not come up')
         for i, (x, y) in enumerate(ROUTE):

@@ -1,7 +1,7 @@
 """Rigid transforms: 4x4 numpy matrices (URDF/SDF xyz + roll-pitch-yaw), planar poses (x, y, yaw),
 quaternions (x, y, z, w). Metres and radians."""
 import math
-from typing import Sequence, Tuple
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -53,6 +53,26 @@ def yaw_to_quaternion(yaw: float) -> Tuple[float, float, float, float]:
 
 def quaternion_to_yaw(x: float, y: float, z: float, w: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def check_planar_quaternion(q: Sequence[float], what: str = 'the orientation') -> Tuple[Optional[float], str]:
+    """(yaw, warning) of a quaternion (x, y, z, w) for planar navigation, or (None, why) when it
+    cannot be used (ROS's isQuaternionValid): NaN, zero length or tilted. One that is not unit length
+    is normalized, and the warning (else '') says so; `what` names it in the messages."""
+    v = np.array(q, float)
+    if not np.all(np.isfinite(v)):
+        return None, '%s has NaN or infinite components' % what
+    n = float(np.linalg.norm(v))
+    if n < 1e-6:
+        return None, '%s is a zero quaternion (length %.3g); it has no heading' % (what, n)
+    warning = ''
+    if abs(n - 1.0) > 1e-3:
+        warning = '%s (%.3f, %.3f, %.3f, %.3f) has length %.3f; normalized' % ((what,) + tuple(v) + (n,))
+    x, y, z, w = v / n
+    up = 1.0 - 2.0 * (x * x + y * y)  # z component of the rotated z axis
+    if up < 1.0 - 1e-3:
+        return None, '%s tilts the robot (its z axis must stay vertical for planar navigation)' % what
+    return quaternion_to_yaw(x, y, z, w), warning
 
 
 def matrix_to_quaternion(t: np.ndarray) -> Tuple[float, float, float, float]:

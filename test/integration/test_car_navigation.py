@@ -3,22 +3,19 @@
 the saved map of wall.world. Every amcl_pose is compared with the simulator's ground truth at the
 same simulated time. Tests run in order; each starts where the previous one left the car.
 """
-import bisect
 import math
-import threading
 import unittest
 
-import actionlib
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-from nav_msgs.msg import Odometry
 
 from mbot_slam_navigation.msg import Contact
-from mbot_slam_navigation.ros_msgs import pose_from_msg
-from mbot_slam_navigation.transforms import normalize_angle, yaw_to_quaternion
+from mbot_slam_navigation.nav.action_client import SimpleActionClient
+from mbot_slam_navigation.transforms import yaw_to_quaternion
+from pose_track import PoseTrack
 
 # wall.world: three rooms side by side; the left and middle ones join at the top, the middle and
 # right ones at the bottom. The car starts at the origin, in the middle room, facing +x.
@@ -30,46 +27,13 @@ WRONG_START = (0.7, 0.5, 0.3)  # the initial pose a user gets wrong: 0.86 m and 
 class CarNavigationTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.lock = threading.Lock()
-        cls.truth_t, cls.truth = [], []
-        cls.estimates = []  # (stamp [s], pose)
+        cls.track = PoseTrack('/amcl_pose')
         cls.contacts = []
-        rospy.Subscriber('/base_pose_ground_truth', Odometry, cls.on_truth, queue_size=100)
-        rospy.Subscriber('/amcl_pose', PoseWithCovarianceStamped, cls.on_estimate, queue_size=10)
         rospy.Subscriber('/gazebo/contacts', Contact, cls.contacts.append)
-        cls.client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+        cls.client = SimpleActionClient('move_base', MoveBaseAction)
         assert cls.client.wait_for_server(rospy.Duration(120.0)), 'no move_base action server'
         rospy.wait_for_message('/amcl_pose', PoseWithCovarianceStamped, timeout=60.0)
         cls.initial_pub = rospy.Publisher('/initialpose', PoseWithCovarianceStamped, queue_size=1, latch=True)
-
-    @classmethod
-    def on_truth(cls, msg):
-        with cls.lock:
-            cls.truth_t.append(msg.header.stamp.to_sec())
-            cls.truth.append(pose_from_msg(msg.pose.pose))
-
-    @classmethod
-    def on_estimate(cls, msg):
-        with cls.lock:
-            cls.estimates.append((msg.header.stamp.to_sec(), pose_from_msg(msg.pose.pose)))
-
-    def truth_at(self, t):
-        with self.lock:
-            i = bisect.bisect_left(self.truth_t, t)
-            candidates = [j for j in (i - 1, i) if 0 <= j < len(self.truth_t)]
-            j = min(candidates, key=lambda k: abs(self.truth_t[k] - t))
-            return self.truth_t[j], self.truth[j]
-
-    def errors_since(self, t0):
-        """(stamp, position error [m], yaw error [rad]) of every estimate stamped after t0."""
-        with self.lock:
-            estimates = [e for e in self.estimates if e[0] > t0]
-        out = []
-        for t, (x, y, yaw) in estimates:
-            tt, (gx, gy, gyaw) = self.truth_at(t)
-            if abs(tt - t) < 0.05:
-                out.append((t, math.hypot(x - gx, y - gy), abs(normalize_angle(yaw - gyaw))))
-        return out
 
     def go(self, target, timeout=240.0):
         g = MoveBaseGoal()
@@ -87,9 +51,9 @@ class CarNavigationTest(unittest.TestCase):
         for goal in GOALS:
             state, text = self.go(goal)
             self.assertEqual(state, GoalStatus.SUCCEEDED, 'goal %s: %s' % (goal, text))
-            _, (x, y, _) = self.truth_at(rospy.get_time())
+            _, (x, y, _) = self.track.truth_at(rospy.get_time())
             self.assertLess(math.hypot(x - goal[0], y - goal[1]), 0.1 + TRACK_TOL, 'goal %s, truth (%.2f, %.2f)' % (goal, x, y))
-        errors = self.errors_since(t0)
+        errors = self.track.errors_since(t0)
         self.assertGreater(len(errors), 40, 'amcl updated only %d times over three goals' % len(errors))
         worst = max(errors, key=lambda e: e[1])
         rospy.loginfo('amcl tracking: %d estimates, worst %.3f m at t=%.1f, mean %.3f m', len(errors), worst[1],
@@ -99,7 +63,7 @@ class CarNavigationTest(unittest.TestCase):
         self.assertEqual([c for c in self.contacts if 'robot' in (c.model_a, c.model_b)], [], 'the car touched a wall')
 
     def test_2_wrong_initial_pose_within_1m_recovers(self):
-        _, truth = self.truth_at(rospy.get_time())
+        _, truth = self.track.truth_at(rospy.get_time())
         wrong = (truth[0] + WRONG_START[0], truth[1] + WRONG_START[1], truth[2] + WRONG_START[2])
         msg = PoseWithCovarianceStamped()
         msg.header.frame_id = 'map'
@@ -112,11 +76,11 @@ class CarNavigationTest(unittest.TestCase):
         t0 = rospy.get_time()
         self.initial_pub.publish(msg)
         rospy.sleep(1.0)
-        first = self.errors_since(t0)
+        first = self.track.errors_since(t0)
         self.assertTrue(first and first[0][1] > 0.4, 'the wrong pose was not taken: %s' % first[:1])
         # Drive on; the estimate must come back to the truth and stay there.
         state, text = self.go((0.0, 3.4, math.pi / 2))
-        errors = self.errors_since(t0)
+        errors = self.track.errors_since(t0)
         settled = [e for e in errors if e[0] > errors[0][0] + 0.6 * (errors[-1][0] - errors[0][0])]
         rospy.loginfo('wrong start: first error %.2f m, last %.3f m, %d estimates', errors[0][1], errors[-1][1],
                       len(errors))

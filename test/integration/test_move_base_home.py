@@ -7,7 +7,6 @@ the previous one left the robot. Positions are checked against the simulator's g
 import math
 import unittest
 
-import actionlib
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus
@@ -17,6 +16,7 @@ from nav_msgs.msg import Odometry, Path
 from nav_msgs.srv import GetPlan, GetPlanRequest
 
 from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.srv import GetModelState, SpawnModel, SpawnModelRequest
 from mbot_slam_navigation.transforms import normalize_angle, quaternion_to_yaw, yaw_to_quaternion
 
@@ -50,7 +50,7 @@ def goal_msg(x, y, yaw=None, quaternion=None, frame='map'):
 class MoveBaseHomeTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+        cls.client = SimpleActionClient('move_base', MoveBaseAction)
         assert cls.client.wait_for_server(rospy.Duration(120.0)), 'no move_base action server'
         rospy.wait_for_message('/move_base/global_costmap/costmap', rospy.AnyMsg, timeout=60.0)
         cls.get_state = rospy.ServiceProxy('/gazebo/get_model_state', GetModelState)

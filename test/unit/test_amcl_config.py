@@ -2,13 +2,12 @@
 values naming their key, and when the filter updates (the Localizer shared by node and bench)."""
 import math
 import os
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-import yaml
 
 from mbot_slam_navigation import _core
+from mbot_slam_navigation.launch_files import node_params
 from mbot_slam_navigation.nav.amcl import read_parameters
 from mbot_slam_navigation.nav.localizer import Localizer
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
@@ -17,8 +16,8 @@ from mbot_slam_navigation.transforms import compose2d
 LAUNCH = os.path.join(os.path.dirname(__file__), '..', '..', 'launch', 'amcl_diff.launch')
 
 
-def launch_values():
-    return {p.get('name'): yaml.safe_load(p.get('value')) for p in ET.parse(LAUNCH).getroot().iter('param')}
+def launch_values(*args):
+    return node_params(LAUNCH, '/amcl', args)
 
 
 def test_amcl_diff_launch_reads_without_warnings_and_keeps_the_example_values():

@@ -124,6 +124,7 @@ class AmclNode:
         self.laser_cache = {}   # frame_id -> (x [m], y [m], 3x3 rotation) of the laser in the base frame
         self.map_to_odom: Optional[Tuple[float, float, float]] = None
         self.last_estimate: Optional[Tuple[float, float, float]] = None
+        self.last_cov = self.s['initial_cov']  # (xx [m^2], yy [m^2], aa [rad^2]) of the last estimate
         self.last_cloud_time = rospy.Time(0)
 
         self.tf = tf2_ros.Buffer(rospy.Duration(30.0))
@@ -183,9 +184,13 @@ class AmclNode:
         with self.lock:
             self.pf.set_map(amap)
             self.map_received = True
-            # A new map: start again from the current estimate, else from the initial pose parameters.
-            mean = self.last_estimate or self.s['initial_pose']
-            self.pf.init_gaussian(np.array(mean), np.diag(self.s['initial_cov']))
+            # A new map (SLAM publishes one every few seconds): start again from the last estimate and
+            # its spread, as ROS amcl does through the pose it saves; else from the initial pose.
+            if self.last_estimate is not None:
+                mean, cov = self.last_estimate, self.last_cov
+            else:
+                mean, cov = self.s['initial_pose'], self.s['initial_cov']
+            self.pf.init_gaussian(np.array(mean), np.diag(cov))
             self.loc.reinitialized()
         rospy.loginfo('amcl: received a %d x %d map @ %.3f m/cell; %d particles around (%.2f, %.2f, %.2f)',
                       info.width, info.height, info.resolution, self.params.max_particles, *mean)
@@ -331,6 +336,7 @@ class AmclNode:
         msg.pose.covariance = c
         self.pose_pub.publish(msg)
         self.last_estimate = (x, y, yaw)
+        self.last_cov = (cov[0, 0], cov[1, 1], cov[2, 2])
         self.map_to_odom = self.loc.map_to_odom(self.last_estimate)
 
     def publish_cloud(self, stamp):
@@ -365,6 +371,8 @@ class AmclNode:
         rospy.set_param('~initial_pose_x', x)
         rospy.set_param('~initial_pose_y', y)
         rospy.set_param('~initial_pose_a', yaw)
+        for key, value in zip(('initial_cov_xx', 'initial_cov_yy', 'initial_cov_aa'), self.last_cov):
+            rospy.set_param('~' + key, float(value))
 
 
 def main() -> None:

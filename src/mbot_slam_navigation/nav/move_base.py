@@ -31,7 +31,7 @@ from mbot_slam_navigation.nav.costmap_ros import CostmapROS
 from mbot_slam_navigation.nav.params import ParamError, ParamReader, nearest_key
 from mbot_slam_navigation.nav.trajectory_planner import TrajectoryController, local_planner_params
 from mbot_slam_navigation.ros_msgs import pose_msg
-from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw
+from mbot_slam_navigation.transforms import check_planar_quaternion, compose2d, normalize_angle, quaternion_to_yaw
 
 PLANNING, CONTROLLING, CLEARING = 'planning', 'controlling', 'clearing'
 GLOBAL_PLANNERS = {'navfn/NavfnROS': 'NavfnROS', 'global_planner/GlobalPlanner': 'GlobalPlanner'}
@@ -39,24 +39,6 @@ LOCAL_PLANNERS = {'base_local_planner/TrajectoryPlannerROS': 'TrajectoryPlannerR
                   'dwa_local_planner/DWAPlannerROS': 'DWAPlannerROS'}
 RECOVERY_TYPES = ('clear_costmap_recovery/ClearCostmapRecovery', 'rotate_recovery/RotateRecovery',
                   'mbot_slam_navigation/BackUpRecovery', 'moveback_recovery/MoveBackRecovery')
-
-
-def check_quaternion(q) -> Tuple[Optional[float], str]:
-    """(yaw, warning) of a goal orientation, or (None, why) when it cannot be used (ROS's isQuaternionValid)."""
-    v = np.array([q.x, q.y, q.z, q.w], float)
-    if not np.all(np.isfinite(v)):
-        return None, 'the goal orientation has NaN or infinite components'
-    n = float(np.linalg.norm(v))
-    if n < 1e-6:
-        return None, 'the goal orientation is a zero quaternion (length %.3g); it has no heading' % n
-    warning = ''
-    if abs(n - 1.0) > 1e-3:
-        warning = 'the goal orientation (%.3f, %.3f, %.3f, %.3f) has length %.3f; normalized' % (q.x, q.y, q.z, q.w, n)
-    x, y, z, w = v / n
-    up = 1.0 - 2.0 * (x * x + y * y)  # z component of the rotated z axis
-    if up < 1.0 - 1e-3:
-        return None, 'the goal orientation tilts the robot (its z axis must stay vertical for planar navigation)'
-    return quaternion_to_yaw(x, y, z, w), warning
 
 
 def pose_stamped(header, x: float, y: float, yaw: float) -> PoseStamped:
@@ -225,7 +207,7 @@ class MoveBase:
         if not heading_required and (o.x, o.y, o.z, o.w) == (0.0, 0.0, 0.0, 0.0):
             yaw, note = 0.0, ''
         else:
-            yaw, note = check_quaternion(o)
+            yaw, note = check_planar_quaternion((o.x, o.y, o.z, o.w), 'the goal orientation')
         if yaw is None:
             return None, note
         if note:

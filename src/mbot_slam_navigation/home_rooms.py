@@ -1,0 +1,52 @@
+"""The simulated home's rooms (worlds/mbot_sim_gazebo_navigation.world, the table in DESIGN.md) and
+how much of each a saved map has seen. World frame = the map frame of a SLAM run started at the
+spawn point (0, 0, 0); metres."""
+from dataclasses import dataclass
+from typing import Dict
+
+import numpy as np
+
+from mbot_slam_navigation.maps.map_io import SAVER_FREE, LoadedMap
+
+
+@dataclass(frozen=True)
+class Room:
+    name: str
+    xmin: float
+    xmax: float
+    ymin: float
+    ymax: float
+
+
+HOME_ROOMS = (
+    Room('living room', -5.4, 1.2, -6.0, 0.9),
+    Room('kitchen', 1.2, 4.5, -6.0, -3.6),
+    Room('dining room', 1.2, 4.5, -3.6, -1.2),
+    Room('bathroom', 1.2, 4.5, -1.2, 0.9),
+    Room('second bedroom', 0.2, 4.5, 0.9, 3.6),
+    Room('study', -2.0, 0.2, 0.9, 3.6),
+    Room('master bedroom', -5.4, -2.0, 0.9, 3.6),
+    Room('balcony', -7.5, -5.4, -4.2, 0.0),
+)
+
+
+def room_coverage(m: LoadedMap, truth: np.ndarray, truth_origin, truth_resolution: float,
+                  margin: float = 0.15) -> Dict[str, float]:
+    """For each room, the share of its truly free floor (cells of `truth`, the world rasterized at
+    `truth_resolution` with origin `truth_origin`, 0 = free, more than `margin` from its walls) that
+    the map `m` marks free. A floor point the map does not cover counts as unseen."""
+    h, w = truth.shape
+    xs = truth_origin[0] + (np.arange(w) + 0.5) * truth_resolution
+    ys = truth_origin[1] + (np.arange(h) + 0.5) * truth_resolution
+    gx, gy = np.meshgrid(xs, ys)
+    col = np.floor((gx - m.origin[0]) / m.resolution).astype(int)
+    row = np.floor((gy - m.origin[1]) / m.resolution).astype(int)
+    inside = (col >= 0) & (col < m.data.shape[1]) & (row >= 0) & (row < m.data.shape[0])
+    seen_free = np.zeros_like(inside)
+    seen_free[inside] = (m.data[row[inside], col[inside]] >= 0) & (m.data[row[inside], col[inside]] <= SAVER_FREE)
+    out = {}
+    for r in HOME_ROOMS:
+        floor = ((truth == 0) & (gx > r.xmin + margin) & (gx < r.xmax - margin)
+                 & (gy > r.ymin + margin) & (gy < r.ymax - margin))
+        out[r.name] = float(seen_free[floor].mean()) if floor.any() else 0.0
+    return out

@@ -1,0 +1,330 @@
+"""random_navigation.py of the exploration tutorial: move_base goals to named points in random order,
+round after round, with the success rate, running time and distance in the log.
+
+Faithful to the tutorial's script (its nine points p1..p9, ~rest_time, the goal-state names, 300 s per
+goal, the log lines, a shutdown that cancels the goal and stops the robot), with its bugs fixed:
+- `random.sample()` over a dict fails in Python 3: the names are shuffled as a list;
+- the "make sure we have an initial position" loop compared a stamp with "" and never waited: it
+  now waits for the robot's pose in the goal frame (SLAM's map -> base_footprint), and that pose is
+  where the first distance is measured from;
+- the initial-pose callback had no subscriber: `initialpose` (rviz's 2D Pose Estimate) now updates
+  where the next distance is measured from, as the tutorial's "Updating current pose." intended;
+- the points' quaternions are not unit length: each is normalized once, with a warning;
+- `trunc()` broke on numbers printed in exponent form: it truncates arithmetically;
+- a round whose first point repeats the last one skipped it, so that round had eight points: the
+  repeated point is swapped later in the round instead, so every round visits every point.
+
+Parameters (private): rest_time (2 s), locations_file ('' = the tutorial's table; see
+config/wall_locations.yaml for the format), max_goals (0 = forever), max_duration (0 = forever, s
+of ROS time), goal_timeout (300 s), seed (-1 = random), frame_id ('map'), base_frame
+('base_footprint'), server_timeout (60 s). With a limit it prints a summary and exits 0.
+"""
+import math
+import os
+import random
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import rospy
+import tf2_ros
+import yaml
+from actionlib_msgs.msg import GoalStatus
+from geometry_msgs.msg import Point, Pose, PoseWithCovarianceStamped, Quaternion, Twist
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+
+from mbot_slam_navigation.nav.action_client import SimpleActionClient
+from mbot_slam_navigation.nav.params import ParamError, ParamReader
+from mbot_slam_navigation.transforms import check_planar_quaternion, yaw_to_quaternion
+
+# actionlib_msgs/GoalStatus's states, in the order of their numbers (the tutorial's goal_states).
+GOAL_STATES = ['PENDING', 'ACTIVE', 'PREEMPTED', 'SUCCEEDED', 'ABORTED', 'REJECTED', 'PREEMPTING', 'RECALLING',
+               'RECALLED', 'LOST']
+
+
+@dataclass
+class Location:
+    name: str
+    room: str
+    x: float                      # [m] in the goal frame (map)
+    y: float
+    orientation: Tuple[float, float, float, float]  # unit quaternion (x, y, z, w)
+    note: str = ''                # why the orientation was changed, if it was
+
+
+# The tutorial's table, verbatim (x, y, quaternion x, y, z, w), with the rooms its text names.
+TUTORIAL_LOCATIONS = [
+    ('p1', 'kitchen', 3.057, -4.795, (0.000, 0.000, 0.000, 0.168)),
+    ('p2', 'dining room', 2.495, -2.381, (0.000, 0.000, 0.063, 0.347)),
+    ('p3', 'bathroom', 3.240, -0.014, (0.000, 0.000, 0.946, -2.675)),
+    ('p4', 'second bedroom', 2.336, 2.304, (0.000, 0.000, 0.139, -0.084)),
+    ('p5', 'study', -0.831, 2.264, (0.000, 0.000, 0.919, -0.433)),
+    ('p6', 'master bedroom, point 1', -3.523, 1.825, (0.000, 0.000, 0.627, 2.071)),
+    ('p7', 'master bedroom, point 2', -4.002, 1.644, (0.000, 0.000, 0.139, -1.119)),
+    ('p8', 'balcony, point 1', -6.420, -2.611, (0.000, 0.000, 0.919, -1.839)),
+    ('p9', 'balcony, point 2', -6.420, -1.372, (0.000, 0.000, 0.627, 1.440)),
+]
+
+
+class LocationsError(ValueError):
+    """A locations table that cannot be used; the message names the file and the key."""
+
+    def __init__(self, path: str, key: str, message: str):
+        self.path, self.key = path, key
+        super().__init__("%s: key '%s': %s" % (path, key, message))
+
+
+def make_location(name: str, room: str, x: float, y: float, quaternion: Sequence[float], where: str) -> Location:
+    """A Location with a unit quaternion; raises LocationsError(where, name...) for an unusable one."""
+    yaw, note = check_planar_quaternion(quaternion, "%s's orientation" % name)
+    if yaw is None:
+        raise LocationsError(where, name + '.orientation', note)
+    return Location(name, room, float(x), float(y), yaw_to_quaternion(yaw), note)
+
+
+def tutorial_locations() -> List[Location]:
+    return [make_location(n, room, x, y, q, 'the built-in table') for n, room, x, y, q in TUTORIAL_LOCATIONS]
+
+
+def _numbers(path: str, key: str, value, lengths: Tuple[int, ...], what: str) -> List[float]:
+    if (not isinstance(value, (list, tuple)) or len(value) not in lengths
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)):
+        raise LocationsError(path, key, 'must be %s, got %r' % (what, value))
+    return [float(v) for v in value]
+
+
+def load_locations(path: str) -> List[Location]:
+    """The points of a locations YAML file, in file order. The file maps each name to
+    `{room: TEXT, position: [x, y] or [x, y, z], orientation: [x, y, z, w]}` or `{..., yaw: RAD}`
+    (metres and radians in the goal frame). Raises LocationsError naming the file and key."""
+    try:
+        with open(path) as f:
+            doc = yaml.safe_load(f)
+    except OSError as e:
+        raise LocationsError(path, '', 'cannot read the file: %s' % e.strerror) from e
+    except yaml.YAMLError as e:
+        raise LocationsError(path, '', 'not valid YAML: %s' % e) from e
+    if not isinstance(doc, dict) or not doc:
+        raise LocationsError(path, '', 'must map point names to {position, orientation or yaw}, got %r' % (doc,))
+    out = []
+    for name, spec in doc.items():
+        name = str(name)
+        if not isinstance(spec, dict):
+            raise LocationsError(path, name, 'must be a mapping with position and orientation or yaw, got %r' % (spec,))
+        unknown = set(spec) - {'room', 'position', 'orientation', 'yaw'}
+        if unknown:
+            raise LocationsError(path, '%s.%s' % (name, sorted(unknown)[0]),
+                                 'unknown key (known: room, position, orientation, yaw)')
+        if 'position' not in spec:
+            raise LocationsError(path, name + '.position', 'missing')
+        pos = _numbers(path, name + '.position', spec['position'], (2, 3), '[x, y] or [x, y, z] in metres')
+        if ('orientation' in spec) == ('yaw' in spec):
+            raise LocationsError(path, name, 'give exactly one of orientation [x, y, z, w] and yaw [rad]')
+        if 'yaw' in spec:
+            q = yaw_to_quaternion(_numbers(path, name + '.yaw', [spec['yaw']], (1,), 'a number of radians')[0])
+        else:
+            q = _numbers(path, name + '.orientation', spec['orientation'], (4,), 'a quaternion [x, y, z, w]')
+        out.append(make_location(name, str(spec.get('room', '')), pos[0], pos[1], q, path))
+    return out
+
+
+def trunc(f: float, n: int) -> float:
+    """f cut (towards zero) to n decimals: the tutorial's helper, which sliced str(f) and broke on
+    numbers that print in exponent form."""
+    scale = 10 ** n
+    return math.trunc(f * scale) / scale
+
+
+def next_round(rng: random.Random, names: Sequence[str], last: str) -> List[str]:
+    """A random order of all the names that does not start with `last` (no goal twice in a row)."""
+    order = list(names)
+    rng.shuffle(order)
+    if len(order) > 1 and order[0] == last:
+        k = rng.randrange(1, len(order))
+        order[0], order[k] = order[k], order[0]
+    return order
+
+
+@dataclass
+class Tally:
+    """What the tutorial logs after every goal, and the summary at the end."""
+    goals: int = 0
+    successes: int = 0
+    distance: float = 0.0             # [m] straight lines to the goals reached, as the tutorial counts
+    outcomes: Dict[str, List[str]] = field(default_factory=dict)  # location -> state names
+
+    def record(self, location: str, state: str, distance: float) -> None:
+        self.goals += 1
+        self.outcomes.setdefault(location, []).append(state)
+        if state == 'SUCCEEDED':
+            self.successes += 1
+            self.distance += distance
+
+    def success_line(self) -> str:
+        rate = 100 * self.successes // self.goals if self.goals else 0
+        return 'Success so far: %d/%d = %d%%' % (self.successes, self.goals, rate)
+
+    def time_line(self, running_time_s: float) -> str:
+        return 'Running time: %s min Distance: %s m' % (trunc(running_time_s / 60.0, 1), trunc(self.distance, 1))
+
+    def summary(self, running_time_s: float, locations: Sequence[Location]) -> str:
+        lines = ['Random navigation summary: %d goals, %d succeeded (%.1f%%), %.1f min, %.1f m'
+                 % (self.goals, self.successes, 100.0 * self.successes / self.goals if self.goals else 0.0,
+                    running_time_s / 60.0, self.distance)]
+        for loc in locations:
+            states = self.outcomes.get(loc.name, [])
+            reached = sum(s == 'SUCCEEDED' for s in states)
+            failed = ', '.join(sorted(set(s for s in states if s != 'SUCCEEDED')))
+            lines.append('  %s %-28s %d/%d%s' % (loc.name, '(%s)' % loc.room if loc.room else '', reached, len(states),
+                                                 '  failed: ' + failed if failed else ''))
+        return '\n'.join(lines)
+
+
+class RandomNavigation:
+    """The node (the tutorial's NavTest): run() sends the goals and returns the exit code."""
+
+    def __init__(self):
+        r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+        self.rest_time = r.number('rest_time', 2.0, minimum=0.0)
+        self.max_goals = r.integer('max_goals', 0, minimum=0)
+        self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
+        self.goal_timeout = r.number('goal_timeout', 300.0, positive=True)
+        self.server_timeout = r.number('server_timeout', 60.0, positive=True)
+        self.frame_id = r.frame('frame_id', 'map')
+        self.base_frame = r.frame('base_frame', 'base_footprint')
+        seed = r.integer('seed', -1)
+        locations_file = r.string('locations_file', '')
+        r.report_unknown()
+        self.locations = load_locations(os.path.expanduser(locations_file)) if locations_file else tutorial_locations()
+        for loc in self.locations:
+            if loc.note:
+                rospy.logwarn('random_navigation: %s', loc.note)
+        self.rng = random.Random(None if seed < 0 else seed)
+
+        self.cmd_vel_pub = rospy.Publisher('cmd_vel', Twist, queue_size=5)
+        self.move_base = SimpleActionClient('move_base', MoveBaseAction)
+        self.tf = tf2_ros.Buffer()
+        self.tf_listener = tf2_ros.TransformListener(self.tf)
+        self.new_pose: Optional[Tuple[float, float]] = None
+        rospy.Subscriber('initialpose', PoseWithCovarianceStamped, self.update_initial_pose, queue_size=1)
+        self.goal_active = False
+        self.tally = Tally()
+        self.start_time = None
+
+    def update_initial_pose(self, msg) -> None:
+        self.new_pose = (msg.pose.pose.position.x, msg.pose.pose.position.y)
+
+    def robot_position(self, timeout: float) -> Optional[Tuple[float, float]]:
+        """Where the robot is in the goal frame (from tf), or None when tf has no answer in time."""
+        try:
+            t = self.tf.lookup_transform(self.frame_id, self.base_frame, rospy.Time(0),
+                                         rospy.Duration(timeout))
+        except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as e:
+            rospy.logwarn('random_navigation: no transform %s -> %s yet: %s', self.frame_id, self.base_frame, e)
+            return None
+        return t.transform.translation.x, t.transform.translation.y
+
+    def goal(self, loc: Location):
+        g = MoveBaseGoal()
+        g.target_pose.pose = Pose(Point(loc.x, loc.y, 0.0), Quaternion(*loc.orientation))
+        g.target_pose.header.frame_id = self.frame_id
+        g.target_pose.header.stamp = rospy.Time.now()
+        return g
+
+    def limit_reached(self) -> bool:
+        if self.max_goals and self.tally.goals >= self.max_goals:
+            return True
+        return bool(self.max_duration) and self.running_time() >= self.max_duration
+
+    def running_time(self) -> float:
+        return (rospy.Time.now() - self.start_time).to_sec()
+
+    def run(self) -> int:
+        rospy.loginfo('Waiting for move_base action server...')
+        if not self.move_base.wait_for_server(rospy.Duration(self.server_timeout)):
+            if not rospy.is_shutdown():
+                rospy.logerr('random_navigation: no move_base action server on %s after %g s; is move_base running? '
+                             '(roslaunch mbot_slam_navigation robot_gazebo_navigation_move.launch)',
+                             rospy.resolve_name('move_base'), self.server_timeout)
+            return 1
+        rospy.loginfo('Connected to move base server')
+
+        # Make sure there is an initial position: the robot's pose in the goal frame.
+        position = None
+        while position is None and not rospy.is_shutdown():
+            position = self.robot_position(5.0)
+        if rospy.is_shutdown():
+            return 0
+        by_name = {loc.name: loc for loc in self.locations}
+        names = [loc.name for loc in self.locations]
+        rospy.loginfo('Starting navigation test: %d locations in %s: %s', len(names), self.frame_id, ' '.join(
+            '%s (%s)' % (loc.name, loc.room) if loc.room else loc.name for loc in self.locations))
+        self.start_time = rospy.Time.now()
+        sequence, i, last = [], len(names), ''
+        while not rospy.is_shutdown() and not self.limit_reached():
+            if i == len(names):  # all visited: a new random order
+                sequence, i = next_round(self.rng, names, last), 0
+            loc = by_name[sequence[i]]
+            if self.new_pose is not None:  # a 2D Pose Estimate since the last goal
+                rospy.loginfo('Updating current pose.')
+                position, self.new_pose = self.new_pose, None
+            distance = math.hypot(loc.x - position[0], loc.y - position[1])
+            i += 1
+            rospy.loginfo('Going to: %s%s', loc.name, ' (%s)' % loc.room if loc.room else '')
+            self.move_base.send_goal(self.goal(loc))
+            self.goal_active = True
+            finished_within_time = self.move_base.wait_for_result(rospy.Duration(self.goal_timeout))
+            if rospy.is_shutdown():
+                break  # the shutdown hook cancels the goal; this one is not counted
+            if not finished_within_time:
+                self.move_base.cancel_goal()
+                state = 'TIMED_OUT'
+                rospy.loginfo('Timed out achieving goal')
+            else:
+                code = self.move_base.get_state()
+                state = GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
+                if code == GoalStatus.SUCCEEDED:
+                    rospy.loginfo('Goal succeeded!')
+                    rospy.loginfo('State:' + str(code))
+                else:
+                    rospy.loginfo('Goal failed with error code: ' + state)
+            self.goal_active = False
+            self.tally.record(loc.name, state, distance)
+            # Measured from where the robot was meant to be, as the tutorial does.
+            position, last = (loc.x, loc.y), loc.name
+            rospy.loginfo(self.tally.success_line())
+            rospy.loginfo(self.tally.time_line(self.running_time()))
+            if not self.limit_reached():
+                rospy.sleep(self.rest_time)
+        if self.start_time is not None and not rospy.is_shutdown():
+            self.stop_robot()
+        if self.start_time is not None:
+            rospy.loginfo(self.tally.summary(self.running_time(), self.locations))
+        return 0
+
+    def stop_robot(self) -> None:
+        self.cmd_vel_pub.publish(Twist())
+
+    def shutdown(self) -> None:
+        """Ctrl-C: cancel the goal and stop the robot (wall-clock waits: ROS time may have stopped)."""
+        rospy.loginfo('Stopping the robot...')
+        if self.goal_active:
+            self.move_base.cancel_goal()
+            time.sleep(0.5)
+        self.stop_robot()
+        time.sleep(0.5)
+
+
+def main() -> None:
+    rospy.init_node('random_navigation', anonymous=True)
+    try:
+        node = RandomNavigation()
+    except (ParamError, LocationsError) as e:
+        rospy.logfatal('random_navigation: %s', e)
+        sys.exit(2)
+    rospy.on_shutdown(node.shutdown)
+    code = node.run()
+    rospy.loginfo('Random navigation finished.')
+    rospy.signal_shutdown('random navigation finished')
+    sys.exit(code)
