@@ -243,10 +243,11 @@ class RandomNavigation:
     def run(self) -> int:
         rospy.loginfo('Waiting for move_base action server...')
         if not self.move_base.wait_for_server(rospy.Duration(self.server_timeout)):
-            if not rospy.is_shutdown():
-                rospy.logerr('random_navigation: no move_base action server on %s after %g s; is move_base running? '
-                             '(roslaunch mbot_slam_navigation robot_gazebo_navigation_move.launch)',
-                             rospy.resolve_name('move_base'), self.server_timeout)
+            if rospy.is_shutdown():
+                return 0
+            rospy.logerr('random_navigation: no move_base action server on %s after %g s; is move_base running? '
+                         '(roslaunch mbot_slam_navigation robot_gazebo_navigation_move.launch)',
+                         rospy.resolve_name('move_base'), self.server_timeout)
             return 1
         rospy.loginfo('Connected to move base server')
 
@@ -296,7 +297,10 @@ class RandomNavigation:
             rospy.loginfo(self.tally.success_line())
             rospy.loginfo(self.tally.time_line(self.running_time()))
             if not self.limit_reached():
-                rospy.sleep(self.rest_time)
+                try:
+                    rospy.sleep(self.rest_time)
+                except rospy.ROSInterruptException:
+                    break
         if self.start_time is not None and not rospy.is_shutdown():
             self.stop_robot()
         if self.start_time is not None:
