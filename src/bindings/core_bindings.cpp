@@ -18,6 +18,7 @@
 #include "mbot_slam_navigation/core/grid_raycast.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
+#include "mbot_slam_navigation/core/path_lengths.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "mbot_slam_navigation/core/world2d.h"
 
@@ -527,6 +528,22 @@ PYBIND11_MODULE(_core, m) {
   m.def("_circle_footprint", &mbot::core::circleFootprint, py::arg("radius"));
   m.def("_pad_footprint", &mbot::core::padFootprint, py::arg("footprint"), py::arg("padding"));
   m.def("_inscribed_radius", &mbot::core::inscribedRadius, py::arg("footprint"));
+  m.def(
+      "_path_lengths",
+      [](py::array_t<uint8_t, py::array::c_style | py::array::forcecast> passable, int col, int row) {
+        if (passable.ndim() != 2) throw std::invalid_argument("_path_lengths: passable must be a 2D array");
+        const int h = static_cast<int>(passable.shape(0)), w = static_cast<int>(passable.shape(1));
+        std::vector<uint8_t> cells(passable.data(), passable.data() + passable.size());
+        std::vector<float> d;
+        {
+          py::gil_scoped_release release;
+          d = mbot::core::pathLengths(cells, w, h, mbot::core::Cell{col, row});
+        }
+        py::array_t<float> out({h, w});
+        std::copy(d.begin(), d.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("passable"), py::arg("col"), py::arg("row"));
   m.def("_circumscribed_radius", &mbot::core::circumscribedRadius, py::arg("footprint"));
   m.def("_validate_footprint", &mbot::core::validateFootprint, py::arg("footprint"));
 

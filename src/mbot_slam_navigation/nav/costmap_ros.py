@@ -149,9 +149,11 @@ class CostmapROS:
 
     def publish(self) -> None:
         with self.lock:
-            layered = self.layered
-            data = layered.core.occupancy_data()
-            geometry = (layered.shape, layered.origin, layered.resolution)
+            # The geometry of the grid that was computed, not the layered costmap's: a new map
+            # resizes the latter at once, the former only at the next update.
+            core = self.layered.core
+            data = core.occupancy_data()
+            geometry = ((core.height, core.width), tuple(core.origin), core.resolution)
         stamp = rospy.Time.now()
         h, w = geometry[0]
         # The full grid every time (so a latecomer to the latched topic sees a current one), and the

@@ -1,0 +1,126 @@
+"""The exploration report, ROS-free: the map (map_server format), the map with the robot's path and
+the frontier goals visited (map.png), explored area against time (area.png) and the figures
+(report.json); with the world's ground truth also coverage of the reachable free space and wall
+accuracy. Map frame = world frame (SLAM started at the spawn pose (0, 0, 0)); metres, seconds.
+"""
+import json
+import math
+import os
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import cv2
+import numpy as np
+
+from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupancy_to_image, save_map
+from mbot_slam_navigation.nav.frontiers import Grid
+from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
+from mbot_slam_navigation.sim.sdf_world import World
+
+
+def known_area(m: Grid) -> float:
+    """[m^2] of cells the map knows (free or occupied as map_saver counts them)."""
+    d = m.data.astype(np.int16)
+    return float(np.count_nonzero((d >= 0) & ((d <= SAVER_FREE) | (d >= SAVER_OCCUPIED)))) * m.resolution ** 2
+
+
+def reachable_free_space(world: World, start: Tuple[float, float], robot_radius: float,
+                         resolution: float = 0.05) -> Tuple[np.ndarray, Tuple[float, float]]:
+    """(mask, origin) of the world's free cells that the robot can sweep: those within robot_radius
+    of a centre position reachable from `start` without touching any shape."""
+    truth, origin = rasterize(world, resolution)
+    free = (truth == 0).astype(np.uint8)
+    clearance = cv2.distanceTransform(free, cv2.DIST_L2, 5) * resolution
+    centres = (clearance > robot_radius).astype(np.uint8)
+    r, c = int((start[1] - origin[1]) / resolution), int((start[0] - origin[0]) / resolution)
+    if not centres[r, c]:
+        raise ValueError('the start (%.2f, %.2f) is within %.2f m of a shape' % (start[0], start[1], robot_radius))
+    n, labels = cv2.connectedComponents(centres, connectivity=8)
+    reach = (labels == labels[r, c]).astype(np.uint8)
+    k = 2 * int(math.ceil(robot_radius / resolution)) + 1
+    swept = cv2.dilate(reach, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    return (swept > 0) & (free > 0), origin
+
+
+def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robot_radius: float,
+                         wall_tolerance: float = 0.1) -> Dict[str, float]:
+    mask, origin = reachable_free_space(world, start, robot_radius, m.resolution)
+    rows, cols = np.nonzero(mask)
+    x = origin[0] + (cols + 0.5) * m.resolution
+    y = origin[1] + (rows + 0.5) * m.resolution
+    mr, mc = m.cell_of(x, y)
+    inside = m.inside(mr, mc)
+    seen = np.zeros(len(x), bool)
+    v = m.data[mr[inside], mc[inside]].astype(np.int16)
+    seen[inside] = (v >= 0) & (v <= SAVER_FREE)
+    orows, ocols = np.nonzero(m.data.astype(np.int16) >= SAVER_OCCUPIED)
+    wx, wy = m.centre_of(orows, ocols)
+    d = distance_to_surfaces(world, np.column_stack([wx, wy])) if len(wx) else np.zeros(0)
+    return {
+        'reachable_free_m2': round(float(len(x)) * m.resolution ** 2, 2),
+        'coverage_of_reachable_free': round(float(seen.mean()) if len(seen) else 0.0, 4),
+        'wall_cells': int(len(d)),
+        'walls_within_tolerance': round(float(np.mean(d <= wall_tolerance)) if len(d) else 0.0, 4),
+        'wall_tolerance_m': wall_tolerance,
+        'wall_distance_median_m': round(float(np.median(d)), 4) if len(d) else None,
+        'wall_distance_max_m': round(float(d.max()), 4) if len(d) else None,
+    }
+
+
+def draw_map(m: Grid, path: Sequence[Tuple[float, float]], goals: Sequence[Tuple[float, float, bool]],
+             filename: str) -> None:
+    """The map with the driven path (red) and the goals sent (green reached, orange not)."""
+    img = cv2.cvtColor(occupancy_to_image(m.data.astype(np.int16)), cv2.COLOR_GRAY2BGR)
+    scale = max(1, 900 // max(img.shape[:2]))
+    img = cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_NEAREST)
+    h = m.data.shape[0]
+
+    def px(x, y):
+        return (int((x - m.origin[0]) / m.resolution * scale), int((h - (y - m.origin[1]) / m.resolution) * scale))
+
+    if len(path) > 1:
+        cv2.polylines(img, [np.array([px(x, y) for x, y in path], np.int32)], False, (0, 0, 220), max(1, scale // 2))
+    for x, y, ok in goals:
+        cv2.circle(img, px(x, y), 2 * scale, (0, 170, 0) if ok else (0, 140, 255), -1)
+    cv2.imwrite(filename, img)
+
+
+def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 400)) -> None:
+    """Explored area [m^2] against simulated time [s], with labelled axes."""
+    w, h = size
+    img = np.full((h, w, 3), 255, np.uint8)
+    left, bottom, top, right = 70, 40, 20, 20
+    t = np.array([c[0] for c in curve] or [0.0])
+    a = np.array([c[1] for c in curve] or [0.0])
+    tmax, amax = max(t.max(), 1.0), max(a.max(), 1.0)
+    cv2.line(img, (left, h - bottom), (w - right, h - bottom), (0, 0, 0), 1)
+    cv2.line(img, (left, h - bottom), (left, top), (0, 0, 0), 1)
+    for i in range(5):
+        ty = h - bottom - i * (h - bottom - top) // 4
+        cv2.putText(img, '%.0f' % (amax * i / 4), (5, ty + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
+        tx = left + i * (w - left - right) // 4
+        cv2.putText(img, '%.0f' % (tmax * i / 4), (tx - 10, h - bottom + 18), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
+    cv2.putText(img, 'explored area [m^2] against simulated time [s]', (left + 10, top + 12), cv2.FONT_HERSHEY_SIMPLEX,
+                0.5, (0, 0, 0), 1)
+    pts = np.column_stack([left + t / tmax * (w - left - right), h - bottom - a / amax * (h - bottom - top)])
+    if len(pts) > 1:
+        cv2.polylines(img, [pts.astype(np.int32)], False, (200, 80, 0), 2)
+    cv2.imwrite(filename, img)
+
+
+def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
+                 curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
+                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2) -> Dict:
+    """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures."""
+    os.makedirs(report_dir, exist_ok=True)
+    figures = dict(figures)
+    figures['explored_area_m2'] = round(known_area(m), 2)
+    if world is not None:
+        figures.update(ground_truth_figures(m, world, start, robot_radius))
+    save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
+    draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
+    draw_area(curve, os.path.join(report_dir, 'area.png'))
+    tmp = os.path.join(report_dir, '.report.json.tmp')
+    with open(tmp, 'w') as f:
+        json.dump(figures, f, indent=2)
+    os.replace(tmp, os.path.join(report_dir, 'report.json'))
+    return figures

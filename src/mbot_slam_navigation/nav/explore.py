@@ -1,0 +1,268 @@
+"""explore: autonomous frontier exploration over move_base (stands in for explore_lite, and finishes).
+
+Every 1/planner_frequency seconds: frontiers of the SLAM map, each one's goal = its cell nearest to
+the robot by path on move_base's global costmap (so never inside an obstacle, never unreachable),
+cost = potential_scale * path length - gain_scale * frontier size; the current goal is kept unless
+another beats it by `hysteresis`; a goal move_base aborts, or one the robot makes no progress
+towards within progress_timeout, is blacklisted for blacklist_timeout (after max_tries failures
+for good); a goal reached is not sent again. When no reachable frontier is left, the robot returns
+to its start pose, `explore/complete` (std_msgs/Bool, latched) turns true, and the report is
+written to ~report_dir if set (mbot_slam_navigation.explore_report).
+
+explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
+(move_base/global_costmap/costmap), planner_frequency (0.33 Hz), progress_timeout (30 s),
+potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
+(0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
+transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
+hysteresis (1.0), return_to_start (true), report_dir (''), world_name ('' = the simulator's
+/gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
+progress line), shutdown_when_done (false).
+"""
+import math
+import os
+import time
+from typing import List, Optional, Tuple
+
+import numpy as np
+import rospy
+from actionlib import SimpleGoalState
+import tf2_ros
+from actionlib_msgs.msg import GoalStatus
+from geometry_msgs.msg import Point
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+from nav_msgs.msg import OccupancyGrid
+from std_msgs.msg import Bool, ColorRGBA
+from visualization_msgs.msg import Marker, MarkerArray
+
+from mbot_slam_navigation import explore_report
+from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.nav.action_client import SimpleActionClient
+from mbot_slam_navigation.nav.frontiers import ExploreState, Frontier, Grid, rank_frontiers
+from mbot_slam_navigation.nav.params import ParamReader
+from mbot_slam_navigation.ros_msgs import pose_msg
+from mbot_slam_navigation.transforms import quaternion_to_yaw
+
+
+def grid_of(msg: OccupancyGrid) -> Grid:
+    return Grid(np.asarray(msg.data, np.int8).reshape(msg.info.height, msg.info.width), msg.info.resolution,
+                (msg.info.origin.position.x, msg.info.origin.position.y))
+
+
+class Explore:
+    def __init__(self):
+        r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+        self.base_frame = r.frame('robot_base_frame', 'base_footprint')
+        self.global_frame = r.frame('global_frame', 'map')
+        costmap_topic = r.string('costmap_topic', 'move_base/global_costmap/costmap')
+        r.string('costmap_updates_topic', '')  # explore_lite's; the full costmap topic is enough here
+        map_topic = r.string('map_topic', 'map')
+        self.period = 1.0 / r.number('planner_frequency', 0.33, positive=True)
+        self.potential_scale = r.number('potential_scale', 3.0, minimum=0.0)
+        self.gain_scale = r.number('gain_scale', 1.0, minimum=0.0)
+        if r.number('orientation_scale', 0.0) != 0.0:
+            rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
+        self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
+        self.visualize = r.boolean('visualize', True)
+        self.transform_tolerance = r.number('transform_tolerance', 0.3, positive=True)
+        self.state = ExploreState(progress_timeout=r.number('progress_timeout', 30.0, positive=True),
+                                  blacklist_timeout=r.number('blacklist_timeout', 60.0, minimum=0.0),
+                                  max_tries=r.integer('max_tries', 2, minimum=1),
+                                  hysteresis=r.number('hysteresis', 1.0, minimum=0.0))
+        self.return_to_start = r.boolean('return_to_start', True)
+        self.report_dir = r.string('report_dir', '')
+        self.world_name = r.string('world_name', '') or rospy.get_param('/gazebo/world_name', '')
+        self.robot_radius = r.number('robot_radius', 0.2, positive=True)
+        self.progress_period = r.number('progress_period', 10.0, positive=True)
+        self.shutdown_when_done = r.boolean('shutdown_when_done', False)
+        r.report_unknown()
+
+        self.map: Optional[Grid] = None
+        self.costmap: Optional[Grid] = None
+        self.collisions = 0
+        self.tf = tf2_ros.Buffer()
+        self.tf_listener = tf2_ros.TransformListener(self.tf)
+        rospy.Subscriber(map_topic, OccupancyGrid, self.on_map, queue_size=1, buff_size=2 ** 24)
+        rospy.Subscriber(costmap_topic, OccupancyGrid, self.on_costmap, queue_size=1, buff_size=2 ** 24)
+        rospy.Subscriber('/gazebo/contacts', Contact, self.on_contact)
+        self.marker_pub = rospy.Publisher('explore/frontiers', MarkerArray, queue_size=1, latch=True)
+        self.done_pub = rospy.Publisher('explore/complete', Bool, queue_size=1, latch=True)
+        self.done_pub.publish(Bool(False))
+        self.move_base = SimpleActionClient('move_base', MoveBaseAction)
+
+        self.path: List[Tuple[float, float]] = []
+        self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
+        self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
+        self.goals_failed = 0
+
+    def on_map(self, msg: OccupancyGrid) -> None:
+        self.map = grid_of(msg)
+        if self.start_time is not None:
+            self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
+
+    start_time = None
+
+    def on_costmap(self, msg: OccupancyGrid) -> None:
+        self.costmap = grid_of(msg)
+
+    def on_contact(self, msg: Contact) -> None:
+        self.collisions += 1
+        rospy.logwarn('explore: the robot touched something at (%.2f, %.2f)', msg.pose.x, msg.pose.y)
+
+    def robot_pose(self) -> Optional[Tuple[float, float, float]]:
+        try:
+            t = self.tf.lookup_transform(self.global_frame, self.base_frame, rospy.Time(0),
+                                         rospy.Duration(self.transform_tolerance))
+        except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as e:
+            rospy.logwarn_throttle(10.0, 'explore: no transform %s -> %s: %s' % (self.global_frame, self.base_frame, e))
+            return None
+        q = t.transform.rotation
+        return t.transform.translation.x, t.transform.translation.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
+
+    def record_path(self, _event) -> None:
+        pose = self.robot_pose()
+        if pose is not None:
+            self.path.append(pose[:2])
+
+    def send(self, x: float, y: float, yaw: float) -> None:
+        g = MoveBaseGoal()
+        g.target_pose.header.frame_id = self.global_frame
+        g.target_pose.header.stamp = rospy.Time.now()
+        g.target_pose.pose = pose_msg(x, y, yaw)
+        self.move_base.send_goal(g)
+
+    def publish_markers(self, frontiers: List[Frontier]) -> None:
+        if not self.visualize:
+            return
+        out = MarkerArray()
+        clear = Marker(action=Marker.DELETEALL)
+        clear.header.frame_id = self.global_frame
+        out.markers.append(clear)
+        now = rospy.Time.now()
+        for i, f in enumerate(frontiers):
+            colour = ColorRGBA(0.0, 0.9, 0.0, 1.0) if i == 0 else ColorRGBA(0.0, 0.3, 1.0, 0.8)
+            cells = Marker(type=Marker.POINTS, action=Marker.ADD, ns='frontiers', id=2 * i)
+            cells.header.frame_id, cells.header.stamp = self.global_frame, now
+            cells.scale.x = cells.scale.y = self.map.resolution if self.map else 0.05
+            cells.color = colour
+            cells.pose.orientation.w = 1.0
+            cells.points = [Point(x, y, 0.0) for x, y in f.cells]
+            goal = Marker(type=Marker.SPHERE, action=Marker.ADD, ns='goals', id=2 * i + 1)
+            goal.header.frame_id, goal.header.stamp = self.global_frame, now
+            goal.pose = pose_msg(f.goal[0], f.goal[1], 0.0)
+            goal.scale.x = goal.scale.y = goal.scale.z = 0.15
+            goal.color = colour
+            out.markers += [cells, goal]
+        self.marker_pub.publish(out)
+
+    def finish_goal(self, now: float) -> None:
+        """Takes in move_base's result for the current goal, if it has one."""
+        if self.state.goal is None or self.move_base.simple_state != SimpleGoalState.DONE:
+            return
+        gx, gy = self.state.goal.goal
+        if self.move_base.get_state() == GoalStatus.SUCCEEDED:
+            self.goals.append((gx, gy, True))
+            self.state.reached(now)
+        else:
+            self.goals.append((gx, gy, False))
+            self.goals_failed += 1
+            rospy.logwarn('explore: move_base gave up on (%.2f, %.2f): %s; blacklisted for %.0f s', gx, gy,
+                          self.move_base.get_goal_status_text(), self.state.blacklist_timeout)
+            self.state.fail(now)
+
+    def run(self) -> None:
+        rospy.loginfo('explore: waiting for move_base, the map and the global costmap...')
+        while not self.move_base.wait_for_server(rospy.Duration(5.0)) and not rospy.is_shutdown():
+            rospy.logwarn_throttle(30.0, 'explore: no move_base action server yet on %s' % rospy.resolve_name('move_base'))
+        start = None
+        while not rospy.is_shutdown() and (self.map is None or self.costmap is None or start is None):
+            start = self.robot_pose()
+            rospy.sleep(0.5)
+        if rospy.is_shutdown():
+            return
+        self.start_time = rospy.Time.now()
+        wall0 = time.monotonic()
+        rospy.Timer(rospy.Duration(0.5), self.record_path)
+        rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
+        next_print = 0.0
+        while not rospy.is_shutdown():
+            now = (rospy.Time.now() - self.start_time).to_sec()
+            pose = self.robot_pose()
+            if pose is None:
+                rospy.sleep(self.period)
+                continue
+            self.finish_goal(now)
+            goal = self.state.goal
+            if self.state.stuck(now, pose[:2]):
+                self.goals_failed += 1
+                self.goals.append((goal.goal[0], goal.goal[1], False))
+                rospy.logwarn('explore: no progress for %.0f s; goal blacklisted', self.state.progress_timeout)
+                self.move_base.cancel_goal()
+            frontiers = rank_frontiers(self.map, self.costmap, pose[:2], self.min_frontier_size,
+                                       self.potential_scale, self.gain_scale, self.state.avoid(now),
+                                       self.state.blacklist_radius)
+            self.publish_markers(frontiers)
+            new = self.state.choose(now, frontiers, pose[:2])
+            if new is not None:
+                yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
+                self.send(new.goal[0], new.goal[1], yaw)
+                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m; %d frontiers', new.goal[0],
+                              new.goal[1], new.path_m, new.size_m, len(frontiers))
+            if not frontiers and self.state.goal is None:
+                if self.state.waiting_for_blacklist(now):
+                    rospy.loginfo_throttle(30.0, 'explore: only blacklisted frontiers left; waiting to retry them')
+                else:
+                    break
+            if now >= next_print:
+                next_print = now + self.progress_period
+                print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
+                      'wall' % (explore_report.known_area(self.map), len(frontiers), len(self.goals) + (
+                          self.state.goal is not None), self.goals_failed, now, time.monotonic() - wall0), flush=True)
+            rospy.sleep(self.period)
+        if rospy.is_shutdown():
+            return
+        self.complete(start, wall0)
+
+    def complete(self, start, wall0) -> None:
+        t_explored = (rospy.Time.now() - self.start_time).to_sec()
+        rospy.loginfo('explore: no reachable frontier left after %.0f s; exploration complete', t_explored)
+        self.move_base.cancel_goal()
+        if self.return_to_start:
+            rospy.loginfo('explore: returning to the start pose (%.2f, %.2f)', start[0], start[1])
+            self.send(*start)
+            self.move_base.wait_for_result(rospy.Duration(180.0))
+            pose = self.robot_pose()
+            if pose is not None:
+                self.path.append(pose[:2])
+        self.done_pub.publish(Bool(True))
+        distance = float(np.sum(np.hypot(*np.diff(np.array(self.path), axis=0).T))) if len(self.path) > 1 else 0.0
+        figures = {
+            'outcome': 'complete',
+            'exploration_time_s': round(t_explored, 1),
+            'total_time_s': round((rospy.Time.now() - self.start_time).to_sec(), 1),
+            'wall_time_s': round(time.monotonic() - wall0, 1),
+            'distance_m': round(distance, 2),
+            'goals_sent': len(self.goals),
+            'goals_failed': self.goals_failed,
+            'collisions': self.collisions,
+        }
+        if self.report_dir and self.map is not None:
+            world = None
+            if self.world_name and os.path.isfile(self.world_name):
+                from mbot_slam_navigation.sim.sdf_world import load_world
+                world = load_world(self.world_name)
+            figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
+                                                  self.curve, figures, world, start[:2], self.robot_radius)
+            print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
+                  % os.path.abspath(self.report_dir), flush=True)
+        for k, v in figures.items():
+            print('  %-28s %s' % (k, v), flush=True)
+        rospy.loginfo('explore: exploration complete: %s', figures)
+
+
+def main() -> None:
+    rospy.init_node('explore')
+    node = Explore()
+    node.run()
+    if node.shutdown_when_done or rospy.is_shutdown():
+        return
+    rospy.spin()

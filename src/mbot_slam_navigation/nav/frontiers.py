@@ -1,0 +1,218 @@
+"""Frontier exploration, ROS-free: where the map ends, which of those places the robot can reach,
+and which one to go to next (the explore node's decisions, kept here so they can be tested).
+
+Grids are nav_msgs/OccupancyGrid-like: `data` (rows = y from the origin up, cols = x), -1 unknown,
+0..100 occupancy; `origin` is the world corner [m] of cell (0, 0); everything in the map frame.
+
+A frontier cell is a known cell that is not occupied (any value from 0 up to `occupied_min`, so
+probabilistic maps work too) with an unknown 4-neighbour. Frontier cells group 8-connected; a group
+shorter than `min_frontier_size` [m] (cells x resolution, as explore_lite measures it) is ignored.
+The goal of a frontier is its cell nearest to the robot by path on the global costmap (cells below
+the inscribed cost, known), never its centroid, which may lie inside a wall.
+"""
+import math
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence, Tuple
+
+import cv2
+import numpy as np
+
+from mbot_slam_navigation import _core
+
+COST_INSCRIBED = 99  # costmap_2d's OccupancyGrid translation: 99 inscribed, 100 lethal, -1 unknown
+
+
+@dataclass
+class Grid:
+    data: np.ndarray                 # (rows, cols) occupancy or cost
+    resolution: float                # [m/cell]
+    origin: Tuple[float, float]      # [m] world corner of cell (0, 0)
+
+    def cell_of(self, x, y):
+        """(row, col) arrays of the cells holding world points (x, y) [m] (may lie outside)."""
+        return (np.floor((np.asarray(y) - self.origin[1]) / self.resolution).astype(int),
+                np.floor((np.asarray(x) - self.origin[0]) / self.resolution).astype(int))
+
+    def centre_of(self, rows, cols):
+        """World (x, y) [m] of cell centres."""
+        return (self.origin[0] + (np.asarray(cols) + 0.5) * self.resolution,
+                self.origin[1] + (np.asarray(rows) + 0.5) * self.resolution)
+
+    def inside(self, rows, cols):
+        return (rows >= 0) & (cols >= 0) & (rows < self.data.shape[0]) & (cols < self.data.shape[1])
+
+
+@dataclass
+class Frontier:
+    cells: np.ndarray        # (N, 2) world x, y [m] of its cells
+    size_m: float            # N x resolution
+    goal: Tuple[float, float]
+    path_m: float            # path length from the robot to the goal [m]
+    cost: float              # potential_scale * path_m - gain_scale * size_m (lower is better)
+
+
+def frontier_groups(m: Grid, occupied_min: int = 65) -> List[np.ndarray]:
+    """The frontiers of map m as arrays of (row, col), largest first."""
+    data = m.data.astype(np.int16)
+    unknown = (data < 0).astype(np.uint8)
+    open_known = (data >= 0) & (data < occupied_min)
+    cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+    frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
+    n, labels = cv2.connectedComponents(frontier, connectivity=8)
+    groups = [np.argwhere(labels == k) for k in range(1, n)]
+    return sorted(groups, key=len, reverse=True)
+
+
+def passable(costmap: Grid, m: Grid, occupied_min: int = 65) -> np.ndarray:
+    """Costmap cells the robot's centre may cross: cost below inscribed, and known and not occupied
+    in the map (the costmap may count unknown space as free)."""
+    cost = costmap.data.astype(np.int16)
+    ok = (cost >= 0) & (cost < COST_INSCRIBED)
+    rows, cols = np.indices(cost.shape)
+    x, y = costmap.centre_of(rows, cols)
+    mr, mc = m.cell_of(x, y)
+    inside = m.inside(mr, mc)
+    known_open = np.zeros_like(ok)
+    v = m.data[mr[inside], mc[inside]].astype(np.int16)
+    known_open[inside] = (v >= 0) & (v < occupied_min)
+    return ok & known_open
+
+
+def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_frontier_size: float = 0.5,
+                   potential_scale: float = 3.0, gain_scale: float = 1.0, avoid: Sequence[Tuple[float, float]] = (),
+                   avoid_radius: float = 0.6, goal_reach: float = 0.4, goal_cost_max: int = 50,
+                   occupied_min: int = 65) -> List[Frontier]:
+    """Reachable frontiers, best (lowest cost) first.
+
+    Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
+    visited) do not count. A frontier's goal is the costmap cell nearest to the robot by path among
+    those within goal_reach [m] of its cells with a cost below goal_cost_max (OccupancyGrid scale,
+    0..100: clear of the inflated zone, so move_base will not refuse it as occupied when the
+    obstacle behind the frontier shows up).
+    """
+    rr, rc = costmap.cell_of(robot[0], robot[1])
+    if not costmap.inside(rr, rc):
+        return []
+    open_cells = passable(costmap, m, occupied_min)
+    dist = _core._path_lengths(open_cells.astype(np.uint8), int(rc), int(rr))
+    cost = costmap.data.astype(np.int16)
+    goal_ok = (dist >= 0) & open_cells & (cost < goal_cost_max)
+    k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    avoid = np.asarray(avoid, float).reshape(-1, 2)
+    out = []
+    for g in frontier_groups(m, occupied_min):
+        x, y = m.centre_of(g[:, 0], g[:, 1])
+        if len(avoid):
+            keep = np.min(np.hypot(x[:, None] - avoid[None, :, 0], y[:, None] - avoid[None, :, 1]), axis=1) >= avoid_radius
+            x, y = x[keep], y[keep]
+        size = len(x) * m.resolution
+        if size < min_frontier_size:
+            continue
+        cr, cc = costmap.cell_of(x, y)
+        inside = costmap.inside(cr, cc)
+        if not inside.any():
+            continue
+        near = np.zeros(cost.shape, np.uint8)
+        near[cr[inside], cc[inside]] = 1
+        candidates = (cv2.dilate(near, disc) > 0) & goal_ok
+        if not candidates.any():
+            continue
+        d = np.where(candidates, dist, np.inf)
+        gr, gc = np.unravel_index(int(np.argmin(d)), d.shape)
+        gx, gy = costmap.centre_of(gr, gc)
+        path_m = float(d[gr, gc]) * costmap.resolution
+        out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
+                            potential_scale * path_m - gain_scale * size))
+    return sorted(out, key=lambda f: f.cost)
+
+
+@dataclass
+class Blacklisted:
+    x: float
+    y: float
+    until: float   # [s] when it may be tried again
+    tries: int     # how many times a goal here failed
+
+
+@dataclass
+class ExploreState:
+    """What the explorer decides between planning cycles. Times are seconds of ROS time."""
+    progress_timeout: float = 30.0    # [s] without moving progress_distance: the goal is given up
+    progress_distance: float = 0.2    # [m]
+    blacklist_timeout: float = 60.0   # [s] before a failed goal may be tried again
+    max_tries: int = 2                # failures after which a place stays blacklisted
+    blacklist_radius: float = 0.6     # [m] around a failed or visited goal
+    hysteresis: float = 1.0           # [cost] a new frontier must beat the current goal's by this
+    goal: Optional[Frontier] = None
+    goal_cost: float = math.inf
+    progress_at: Tuple[float, float] = (math.nan, math.nan)
+    progress_time: float = 0.0
+    blacklist: List[Blacklisted] = field(default_factory=list)
+
+    def avoid(self, now: float) -> List[Tuple[float, float]]:
+        return [(b.x, b.y) for b in self.blacklist if b.until > now or b.tries >= self.max_tries]
+
+    def waiting_for_blacklist(self, now: float) -> bool:
+        """True while some place may still be tried again later."""
+        return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
+
+    def choose(self, now: float, frontiers: List[Frontier], robot: Tuple[float, float]) -> Optional[Frontier]:
+        """The frontier to head for (a new goal to send), or None to keep the current goal (or, when
+        there is none and `frontiers` is empty, to stop: see done())."""
+        if not frontiers:
+            self.goal = None
+            return None
+        best = frontiers[0]
+        if self.goal is not None:
+            # The frontier being explored, if still there: the one with cells nearest the goal sent
+            # (its cells and goal shift as the map grows; matching on cells keeps the robot from
+            # flipping between two frontiers whose goals move).
+            gx, gy = self.goal.goal
+            near = [(float(np.min(np.hypot(f.cells[:, 0] - gx, f.cells[:, 1] - gy))), i) for i, f in enumerate(frontiers)]
+            d, i = min(near)
+            current = [frontiers[i]] if d < 1.0 else []
+            if current and best.cost > current[0].cost - self.hysteresis:
+                if math.hypot(current[0].goal[0] - self.goal.goal[0], current[0].goal[1] - self.goal.goal[1]) < 0.25:
+                    return None
+                # The same frontier, but its goal moved (the map grew, or an obstacle appeared near
+                # the old goal): follow it without counting a new goal.
+                self.goal = current[0]
+                return current[0]
+        self.goal, self.goal_cost = best, best.cost
+        self.progress_at, self.progress_time = robot, now
+        return best
+
+    def stuck(self, now: float, robot: Tuple[float, float]) -> bool:
+        """True when the robot has not moved progress_distance within progress_timeout while a goal
+        is active; the goal is then blacklisted and dropped."""
+        if self.goal is None:
+            return False
+        if math.hypot(robot[0] - self.progress_at[0], robot[1] - self.progress_at[1]) >= self.progress_distance:
+            self.progress_at, self.progress_time = robot, now
+            return False
+        if now - self.progress_time > self.progress_timeout:
+            self.fail(now)
+            return True
+        return False
+
+    def fail(self, now: float) -> None:
+        """The current goal failed (aborted by move_base, or no progress): blacklist its place."""
+        if self.goal is None:
+            return
+        gx, gy = self.goal.goal
+        for b in self.blacklist:
+            if math.hypot(b.x - gx, b.y - gy) < self.blacklist_radius:
+                b.tries += 1
+                b.until = now + self.blacklist_timeout
+                break
+        else:
+            self.blacklist.append(Blacklisted(gx, gy, now + self.blacklist_timeout, 1))
+        self.goal = None
+
+    def reached(self, now: float) -> None:
+        """The goal was reached: its place is not sent again (a frontier still there cannot be seen
+        from it, e.g. unknown space under furniture)."""
+        if self.goal is not None:
+            self.blacklist.append(Blacklisted(self.goal.goal[0], self.goal.goal[1], now, self.max_tries))
+        self.goal = None

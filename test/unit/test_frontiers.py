@@ -1,0 +1,150 @@
+"""Frontier search and the explorer's decisions, ROS-free (mbot_slam_navigation.nav.frontiers)."""
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from mbot_slam_navigation import _core
+from mbot_slam_navigation.nav.frontiers import ExploreState, Frontier, Grid, frontier_groups, rank_frontiers
+
+RES = 0.05
+
+
+def room(width_m=4.0, height_m=3.0, door=None, unknown_beyond=True):
+    """A known room (free inside, walls around) inside an unknown 8 x 6 m grid; `door` = (y0, y1) [m]
+    opens its east wall. Origin (0, 0); the room spans (1, 1) .. (1 + width, 1 + height)."""
+    g = np.full((int(6 / RES), int(8 / RES)), -1 if unknown_beyond else 0, np.int8)
+    r0, c0 = int(1 / RES), int(1 / RES)
+    r1, c1 = int((1 + height_m) / RES), int((1 + width_m) / RES)
+    g[r0:r1 + 1, c0:c1 + 1] = 100
+    g[r0 + 1:r1, c0 + 1:c1] = 0
+    if door:
+        g[int((1 + door[0]) / RES):int((1 + door[1]) / RES), c1] = 0
+    return Grid(g, RES, (0.0, 0.0))
+
+
+def costmap_of(m: Grid, inscribed=0.2, radius=0.6, scaling=10.0) -> Grid:
+    """move_base's global costmap of map m in the OccupancyGrid scale (100 lethal, 99 inscribed)."""
+    occupied = (m.data >= 65).astype(np.uint8)
+    d = cv2.distanceTransform(1 - occupied, cv2.DIST_L2, 5) * RES
+    cost = np.zeros(m.data.shape, np.int8)
+    ring = (d > inscribed) & (d <= radius)
+    cost[ring] = np.clip(98 * np.exp(-scaling * (d[ring] - inscribed)), 1, 98).astype(np.int8)
+    cost[d <= inscribed] = 99
+    cost[occupied > 0] = 100
+    return Grid(cost, RES, m.origin)
+
+
+def test_path_lengths_binding():
+    d = _core._path_lengths(np.ones((3, 4), np.uint8), 0, 0)
+    assert d[0, 3] == pytest.approx(3.0) and d[2, 2] == pytest.approx(2 * math.sqrt(2))
+    with pytest.raises(ValueError, match='outside'):
+        _core._path_lengths(np.ones((3, 4), np.uint8), 9, 0)
+
+
+def test_a_closed_room_has_no_frontier_and_an_open_door_has_one():
+    assert frontier_groups(room()) == []
+    groups = frontier_groups(room(door=(1.0, 2.0)))
+    assert len(groups) == 1
+    cols = groups[0][:, 1]
+    assert np.all(cols == int(5 / RES))  # the door cells in the east wall line
+    assert len(groups[0]) == pytest.approx(1.0 / RES, abs=1)
+
+
+def test_any_value_below_occupied_counts_as_known():
+    m = room(door=(1.0, 2.0))
+    m.data[m.data == 0] = 20  # a probabilistic map: "probably free" everywhere
+    assert len(frontier_groups(m)) == 1
+    m.data[m.data == 20] = 50
+    assert len(frontier_groups(m)) == 1
+
+
+def test_goal_is_a_clear_reachable_cell_near_the_frontier_not_its_centroid():
+    # An L-shaped opening: the frontier runs round a corner, its centroid lies in the wall corner.
+    m = room(width_m=4.0, height_m=4.0)
+    r1, c1 = int(5 / RES), int(5 / RES)
+    m.data[r1 - 20:r1 + 1, c1] = 0   # east wall open along its top 1 m
+    m.data[r1, c1 - 20:c1 + 1] = 0   # north wall open along its east 1 m
+    c = costmap_of(m)
+    frontiers = rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.5)
+    assert len(frontiers) == 1
+    f = frontiers[0]
+    gr, gc = c.cell_of(*f.goal)
+    assert c.data[gr, gc] < 50 and m.data[gr, gc] == 0
+    assert np.min(np.hypot(f.cells[:, 0] - f.goal[0], f.cells[:, 1] - f.goal[1])) <= 0.4 + RES  # goal_reach, to the cell
+    cx, cy = f.cells.mean(axis=0)
+    assert math.hypot(cx - f.goal[0], cy - f.goal[1]) > 0.1
+    # the path is at least the straight line, and not absurdly longer
+    straight = math.hypot(f.goal[0] - 2.0, f.goal[1] - 2.0)
+    assert straight - 0.05 <= f.path_m <= 1.3 * straight + 0.2
+
+
+def test_a_frontier_behind_a_wall_is_not_reachable():
+    m = room(door=(1.0, 2.0))
+    m.data[int(1 / RES):int(4 / RES) + 1, int(3 / RES)] = 100  # a wall across the room
+    c = costmap_of(m)
+    assert rank_frontiers(m, c, (2.0, 2.0)) == []      # west of the new wall
+    assert len(rank_frontiers(m, c, (4.0, 2.0))) == 1  # east of it, by the door
+
+
+def test_nearer_and_larger_frontiers_cost_less():
+    m = room(width_m=6.0, door=(0.5, 2.5))
+    m.data[int(4 / RES), int(1.5 / RES):int(2.0 / RES)] = 0  # a 0.5 m gap in the north wall, west
+    c = costmap_of(m)
+    f = rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.3, potential_scale=3.0, gain_scale=1.0)
+    assert len(f) == 2
+    assert f[0].goal[0] < 3.0  # the near small gap wins at potential_scale 3
+    g = rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.3, potential_scale=0.1, gain_scale=1.0)
+    assert g[0].goal[0] > 6.0  # the large door wins when distance hardly counts
+    assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.75)[0].goal[0] > 6.0  # the gap is too small
+
+
+def test_blacklisted_places_are_avoided():
+    m = room(door=(1.0, 2.0))
+    c = costmap_of(m)
+    f = rank_frontiers(m, c, (2.0, 2.0))
+    assert rank_frontiers(m, c, (2.0, 2.0), avoid=[f[0].goal], avoid_radius=1.5) == []
+
+
+def frontier_at(x, y, cost=1.0):
+    return Frontier(np.array([[x, y]]), 1.0, (x, y), 1.0, cost)
+
+
+def test_state_keeps_its_goal_unless_clearly_beaten():
+    s = ExploreState(hysteresis=1.0)
+    a, b = frontier_at(1.0, 1.0, cost=5.0), frontier_at(5.0, 5.0, cost=4.5)
+    assert s.choose(0.0, [a], (0.0, 0.0)) is a
+    assert s.choose(3.0, [b, a], (0.0, 0.0)) is None           # better by 0.5 only: keep a
+    c = frontier_at(5.0, 5.0, cost=3.0)
+    assert s.choose(6.0, [c, a], (0.0, 0.0)) is c               # better by 2: switch
+    moved = frontier_at(5.5, 5.0, cost=3.0)
+    moved.cells = np.array([[5.0, 5.0], [5.5, 5.0]])
+    assert s.choose(9.0, [moved], (0.0, 0.0)) is moved          # same frontier, goal moved: follow it
+    assert s.choose(12.0, [], (0.0, 0.0)) is None and s.goal is None
+
+
+def test_failures_blacklist_expire_and_then_stick():
+    s = ExploreState(blacklist_timeout=60.0, max_tries=2, progress_timeout=30.0)
+    a = frontier_at(1.0, 1.0)
+    s.choose(0.0, [a], (0.0, 0.0))
+    s.fail(10.0)
+    assert s.avoid(20.0) == [(1.0, 1.0)] and s.waiting_for_blacklist(20.0)
+    assert s.avoid(71.0) == [] and not s.waiting_for_blacklist(71.0)  # expired: may be tried again
+    s.choose(71.0, [a], (0.0, 0.0))
+    s.fail(72.0)
+    assert s.avoid(1000.0) == [(1.0, 1.0)]                          # failed twice: for good
+    assert not s.waiting_for_blacklist(1000.0)
+
+
+def test_no_progress_gives_the_goal_up_and_reached_goals_are_not_sent_again():
+    s = ExploreState(progress_timeout=30.0, progress_distance=0.2)
+    s.choose(0.0, [frontier_at(3.0, 0.0)], (0.0, 0.0))
+    assert not s.stuck(20.0, (0.1, 0.0))
+    assert not s.stuck(25.0, (0.3, 0.0))   # moved 0.3 m: the clock restarts
+    assert not s.stuck(50.0, (0.35, 0.0))
+    assert s.stuck(56.0, (0.35, 0.0)) and s.goal is None and s.avoid(57.0) == [(3.0, 0.0)]
+    t = ExploreState()
+    t.choose(0.0, [frontier_at(2.0, 2.0)], (0.0, 0.0))
+    t.reached(10.0)
+    assert t.avoid(1e6) == [(2.0, 2.0)] and not t.waiting_for_blacklist(11.0)
