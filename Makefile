@@ -33,8 +33,12 @@ test: build
 	cd $(WS) && $(SOURCE) && catkin_make -j1 run_tests 2>&1 | tee $(WS)/run-tests.log | grep -E '^\[ *(ROSTEST|OK|FAIL|RUN|PASSED)|^(FAILURE|ERROR|SUMMARY)|passed|failed' || true
 	cd $(WS) && catkin_test_results --verbose build/test_results
 
+# The exploration at 4x real time: the fastest the whole stack keeps up with on two cores (README).
+# RVIZ=1 also opens rviz.
+RVIZ ?= 0
 demo: build
-	cd $(WS) && $(SOURCE) && roslaunch $(PKG) slam_demo.launch report_dir:=$(CURDIR)/report
+	cd $(WS) && $(SOURCE) && roslaunch $(PKG) explore.launch real_time_factor:=4.0 report_dir:=$(CURDIR)/report \
+	  shutdown_when_done:=true rviz:=$(if $(filter 1 true,$(RVIZ)),true,false)
 
 bench: build
 	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/bench/run_all.py

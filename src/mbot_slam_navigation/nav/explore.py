@@ -215,8 +215,8 @@ class Explore:
             if now >= next_print:
                 next_print = now + self.progress_period
                 print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
-                      'wall' % (explore_report.known_area(self.map), len(frontiers), len(self.goals) + (
-                          self.state.goal is not None), self.goals_failed, now, time.monotonic() - wall0), flush=True)
+                      'wall' % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
+                                self.goals_failed, now, time.monotonic() - wall0), flush=True)
             rospy.sleep(self.period)
         if rospy.is_shutdown():
             return
@@ -233,7 +233,6 @@ class Explore:
             pose = self.robot_pose()
             if pose is not None:
                 self.path.append(pose[:2])
-        self.done_pub.publish(Bool(True))
         distance = float(np.sum(np.hypot(*np.diff(np.array(self.path), axis=0).T))) if len(self.path) > 1 else 0.0
         figures = {
             'outcome': 'complete',
@@ -241,7 +240,7 @@ class Explore:
             'total_time_s': round((rospy.Time.now() - self.start_time).to_sec(), 1),
             'wall_time_s': round(time.monotonic() - wall0, 1),
             'distance_m': round(distance, 2),
-            'goals_sent': len(self.goals),
+            'goals_sent': self.state.goals_chosen,
             'goals_failed': self.goals_failed,
             'collisions': self.collisions,
         }
@@ -257,6 +256,7 @@ class Explore:
         for k, v in figures.items():
             print('  %-28s %s' % (k, v), flush=True)
         rospy.loginfo('explore: exploration complete: %s', figures)
+        self.done_pub.publish(Bool(True))  # last, so that the report is on disk when it says so
 
 
 def main() -> None:

@@ -149,6 +149,7 @@ class ExploreState:
     progress_at: Tuple[float, float] = (math.nan, math.nan)
     progress_time: float = 0.0
     blacklist: List[Blacklisted] = field(default_factory=list)
+    goals_chosen: int = 0             # new goals (a goal that moved with its frontier is not new)
 
     def avoid(self, now: float) -> List[Tuple[float, float]]:
         return [(b.x, b.y) for b in self.blacklist if b.until > now or b.tries >= self.max_tries]
@@ -161,7 +162,7 @@ class ExploreState:
         """The frontier to head for (a new goal to send), or None to keep the current goal (or, when
         there is none and `frontiers` is empty, to stop: see done())."""
         if not frontiers:
-            self.goal = None
+            self.reached(now)
             return None
         best = frontiers[0]
         if self.goal is not None:
@@ -172,6 +173,10 @@ class ExploreState:
             near = [(float(np.min(np.hypot(f.cells[:, 0] - gx, f.cells[:, 1] - gy))), i) for i, f in enumerate(frontiers)]
             d, i = min(near)
             current = [frontiers[i]] if d < 1.0 else []
+            if not current:
+                # Its frontier is gone (mapped on the way, or below min_frontier_size now): the place
+                # counts as visited, so that a frontier flickering there does not pull the robot back.
+                self.reached(now)
             if current and best.cost > current[0].cost - self.hysteresis:
                 if math.hypot(current[0].goal[0] - self.goal.goal[0], current[0].goal[1] - self.goal.goal[1]) < 0.25:
                     return None
@@ -180,6 +185,7 @@ class ExploreState:
                 self.goal = current[0]
                 return current[0]
         self.goal, self.goal_cost = best, best.cost
+        self.goals_chosen += 1
         self.progress_at, self.progress_time = robot, now
         return best
 
