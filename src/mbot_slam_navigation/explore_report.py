@@ -55,6 +55,14 @@ def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robo
     orows, ocols = np.nonzero(m.data.astype(np.int16) >= SAVER_OCCUPIED)
     wx, wy = m.centre_of(orows, ocols)
     d = distance_to_surfaces(world, np.column_stack([wx, wy])) if len(wx) else np.zeros(0)
+    # A wall cell whose centre lies inside a solid is on the wall, however far from its surface.
+    truth, torigin = rasterize(world, m.resolution)
+    tr = np.floor((wy - torigin[1]) / m.resolution).astype(int)
+    tc = np.floor((wx - torigin[0]) / m.resolution).astype(int)
+    ok = (tr >= 0) & (tc >= 0) & (tr < truth.shape[0]) & (tc < truth.shape[1])
+    solid = np.zeros(len(d), bool)
+    solid[ok] = truth[tr[ok], tc[ok]] > 0
+    d[solid] = 0.0
     return {
         'reachable_free_m2': round(float(len(x)) * m.resolution ** 2, 2),
         'coverage_of_reachable_free': round(float(seen.mean()) if len(seen) else 0.0, 4),

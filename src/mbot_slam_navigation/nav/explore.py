@@ -40,6 +40,7 @@ from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.frontiers import ExploreState, Frontier, Grid, rank_frontiers
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
+from mbot_slam_navigation.sim.sdf_world import load_world
 from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
@@ -79,6 +80,11 @@ class Explore:
         self.map: Optional[Grid] = None
         self.costmap: Optional[Grid] = None
         self.collisions = 0
+        self.start_time: Optional[rospy.Time] = None  # set when exploring starts
+        self.path: List[Tuple[float, float]] = []
+        self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
+        self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
+        self.goals_failed = 0
         self.tf = tf2_ros.Buffer()
         self.tf_listener = tf2_ros.TransformListener(self.tf)
         rospy.Subscriber(map_topic, OccupancyGrid, self.on_map, queue_size=1, buff_size=2 ** 24)
@@ -89,17 +95,10 @@ class Explore:
         self.done_pub.publish(Bool(False))
         self.move_base = SimpleActionClient('move_base', MoveBaseAction)
 
-        self.path: List[Tuple[float, float]] = []
-        self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
-        self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
-        self.goals_failed = 0
-
     def on_map(self, msg: OccupancyGrid) -> None:
         self.map = grid_of(msg)
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
-
-    start_time = None
 
     def on_costmap(self, msg: OccupancyGrid) -> None:
         self.costmap = grid_of(msg)
@@ -247,7 +246,6 @@ class Explore:
         if self.report_dir and self.map is not None:
             world = None
             if self.world_name and os.path.isfile(self.world_name):
-                from mbot_slam_navigation.sim.sdf_world import load_world
                 world = load_world(self.world_name)
             figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
                                                   self.curve, figures, world, start[:2], self.robot_radius)
