@@ -148,3 +148,28 @@ def test_no_progress_gives_the_goal_up_and_reached_goals_are_not_sent_again():
     t.choose(0.0, [frontier_at(2.0, 2.0)], (0.0, 0.0))
     t.reached(10.0)
     assert t.avoid(1e6) == [(2.0, 2.0)] and not t.waiting_for_blacklist(11.0)
+
+
+def test_unknown_space_inside_furniture_makes_no_frontier_when_asked():
+    m = room(width_m=5.0, height_m=4.0, door=(1.0, 2.0))
+    r, c = int(2.5 / RES), int(2.5 / RES)
+    m.data[r:r + 12, c:c + 20] = 100     # a 1.0 m x 0.6 m table seen from two sides...
+    m.data[r + 1:r + 11, c + 1:c + 19] = -1  # ...whose inside nobody sees
+    m.data[r + 1:r + 11, c + 19] = 0      # and whose east face is not mapped yet
+    assert len(frontier_groups(m)) == 2
+    groups = frontier_groups(m, min_unknown_area=3.0)
+    assert len(groups) == 1 and np.all(groups[0][:, 1] == int(6 / RES))  # the door only
+
+
+def test_a_robot_inside_the_inscribed_zone_still_reaches_out_and_reachable_area_is_reported():
+    m = room(door=(1.0, 2.0))
+    m.data[int(2.0 / RES):int(2.4 / RES), int(2.12 / RES)] = 100  # a post 0.12 m east of the robot
+    c = costmap_of(m)
+    rr, rc = c.cell_of(2.0, 2.2)
+    assert c.data[rr, rc] == 99                                       # the robot stands in the inscribed zone
+    stats = {}
+    f = rank_frontiers(m, c, (2.0, 2.2), stats=stats)
+    assert len(f) == 1 and stats['reachable_m2'] > 5.0
+    stats = {}
+    assert rank_frontiers(m, c, (2.0, 2.2), escape_radius=0.0, stats=stats) == []  # without the escape: boxed in
+    assert stats['reachable_m2'] < 0.01

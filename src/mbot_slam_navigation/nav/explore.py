@@ -14,7 +14,8 @@ explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
 potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
 (0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
 transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
-hysteresis (1.0), return_to_start (true), report_dir (''), world_name ('' = the simulator's
+hysteresis (1.0), min_unknown_area (3 m^2: enclosed unknown space smaller than this, the inside
+of furniture, makes no frontier), return_to_start (true), report_dir (''), world_name ('' = the simulator's
 /gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
 progress line), shutdown_when_done (false).
 """
@@ -32,6 +33,7 @@ from geometry_msgs.msg import Point
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import Bool, ColorRGBA
+from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
 
 from mbot_slam_navigation import explore_report
@@ -42,6 +44,9 @@ from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
 from mbot_slam_navigation.transforms import quaternion_to_yaw
+
+
+BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot is stuck, not done
 
 
 def grid_of(msg: OccupancyGrid) -> Grid:
@@ -63,6 +68,7 @@ class Explore:
         if r.number('orientation_scale', 0.0) != 0.0:
             rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
         self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
+        self.min_unknown_area = r.number('min_unknown_area', 3.0, minimum=0.0)
         self.visualize = r.boolean('visualize', True)
         self.transform_tolerance = r.number('transform_tolerance', 0.3, positive=True)
         self.state = ExploreState(progress_timeout=r.number('progress_timeout', 30.0, positive=True),
@@ -116,6 +122,13 @@ class Explore:
             return None
         q = t.transform.rotation
         return t.transform.translation.x, t.transform.translation.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
+
+    def clear_costmaps(self) -> None:
+        """move_base's ~clear_costmaps, as its recoveries use it; failures are only logged."""
+        try:
+            rospy.ServiceProxy('move_base/clear_costmaps', Empty)()
+        except (rospy.ServiceException, rospy.ROSException) as e:
+            rospy.logwarn_throttle(30.0, 'explore: move_base/clear_costmaps failed: %s' % e)
 
     def record_path(self, _event) -> None:
         pose = self.robot_pose()
@@ -182,7 +195,7 @@ class Explore:
         wall0 = time.monotonic()
         rospy.Timer(rospy.Duration(0.5), self.record_path)
         rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
-        next_print = 0.0
+        next_print, empty_cycles = 0.0, 0
         while not rospy.is_shutdown():
             now = (rospy.Time.now() - self.start_time).to_sec()
             pose = self.robot_pose()
@@ -196,9 +209,11 @@ class Explore:
                 self.goals.append((goal.goal[0], goal.goal[1], False))
                 rospy.logwarn('explore: no progress for %.0f s; goal blacklisted', self.state.progress_timeout)
                 self.move_base.cancel_goal()
+            stats = {}
             frontiers = rank_frontiers(self.map, self.costmap, pose[:2], self.min_frontier_size,
                                        self.potential_scale, self.gain_scale, self.state.avoid(now),
-                                       self.state.blacklist_radius)
+                                       self.state.blacklist_radius, min_unknown_area=self.min_unknown_area,
+                                       stats=stats)
             self.publish_markers(frontiers)
             new = self.state.choose(now, frontiers, pose[:2])
             if new is not None:
@@ -206,10 +221,19 @@ class Explore:
                 self.send(new.goal[0], new.goal[1], yaw)
                 rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m; %d frontiers', new.goal[0],
                               new.goal[1], new.path_m, new.size_m, len(frontiers))
-            if not frontiers and self.state.goal is None:
-                if self.state.waiting_for_blacklist(now):
-                    rospy.loginfo_throttle(30.0, 'explore: only blacklisted frontiers left; waiting to retry them')
-                else:
+            if frontiers or self.state.goal is not None:
+                empty_cycles = 0
+            elif self.state.waiting_for_blacklist(now):
+                rospy.loginfo_throttle(30.0, 'explore: only blacklisted frontiers left; waiting to retry them')
+            elif stats.get('reachable_m2', 0.0) < BOXED_IN_M2:
+                # Not done: the robot is boxed in by its costmap (an obstacle seen beside it, a
+                # stale costmap); move_base's recoveries or the next costmap will free it.
+                rospy.logwarn_throttle(30.0, 'explore: the robot can reach only %.1f m^2 on the global costmap; '
+                                             'clearing the costmaps' % stats.get('reachable_m2', 0.0))
+                self.clear_costmaps()
+            else:
+                empty_cycles += 1  # twice in a row, so that one odd costmap does not end it
+                if empty_cycles >= 2:
                     break
             if now >= next_print:
                 next_print = now + self.progress_period

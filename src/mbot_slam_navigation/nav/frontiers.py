@@ -51,10 +51,22 @@ class Frontier:
     cost: float              # potential_scale * path_m - gain_scale * size_m (lower is better)
 
 
-def frontier_groups(m: Grid, occupied_min: int = 65) -> List[np.ndarray]:
-    """The frontiers of map m as arrays of (row, col), largest first."""
+def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> List[np.ndarray]:
+    """The frontiers of map m as arrays of (row, col), largest first.
+
+    Unknown space that the map encloses (not reaching its edge) and smaller than min_unknown_area
+    [m^2] does not make frontiers: it is the inside of furniture or a pillar, which no sensor sees.
+    """
     data = m.data.astype(np.int16)
     unknown = (data < 0).astype(np.uint8)
+    if min_unknown_area > 0 and unknown.any():
+        n, labels, stats, _ = cv2.connectedComponentsWithStats(unknown, connectivity=8)
+        h, w = unknown.shape
+        x, y, bw, bh, area = (stats[:, i] for i in range(5))
+        at_edge = (x == 0) | (y == 0) | (x + bw == w) | (y + bh == h)
+        keep = at_edge | (area * m.resolution ** 2 >= min_unknown_area)
+        keep[0] = False  # label 0: the known cells
+        unknown = keep[labels].astype(np.uint8)
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
@@ -81,7 +93,8 @@ def passable(costmap: Grid, m: Grid, occupied_min: int = 65) -> np.ndarray:
 def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_frontier_size: float = 0.5,
                    potential_scale: float = 3.0, gain_scale: float = 1.0, avoid: Sequence[Tuple[float, float]] = (),
                    avoid_radius: float = 0.6, goal_reach: float = 0.4, goal_cost_max: int = 50,
-                   occupied_min: int = 65) -> List[Frontier]:
+                   occupied_min: int = 65, min_unknown_area: float = 0.0, escape_radius: float = 0.35,
+                   stats: Optional[dict] = None) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
@@ -94,14 +107,21 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     if not costmap.inside(rr, rc):
         return []
     open_cells = passable(costmap, m, occupied_min)
-    dist = _core._path_lengths(open_cells.astype(np.uint8), int(rc), int(rr))
     cost = costmap.data.astype(np.int16)
+    # Within escape_radius of the robot, any cell short of lethal is passable: a robot that stands
+    # in the inscribed zone (an obstacle appeared beside it) can still back out, as move_base does.
+    rows, cols = np.ogrid[:cost.shape[0], :cost.shape[1]]
+    around = (rows - rr) ** 2 + (cols - rc) ** 2 <= (escape_radius / costmap.resolution) ** 2
+    open_cells = open_cells | (around & (cost >= 0) & (cost < 100))
+    dist = _core._path_lengths(open_cells.astype(np.uint8), int(rc), int(rr))
+    if stats is not None:
+        stats['reachable_m2'] = float(np.count_nonzero(dist >= 0)) * costmap.resolution ** 2
     goal_ok = (dist >= 0) & open_cells & (cost < goal_cost_max)
     k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1
     disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
     avoid = np.asarray(avoid, float).reshape(-1, 2)
     out = []
-    for g in frontier_groups(m, occupied_min):
+    for g in frontier_groups(m, occupied_min, min_unknown_area):
         x, y = m.centre_of(g[:, 0], g[:, 1])
         if len(avoid):
             keep = np.min(np.hypot(x[:, None] - avoid[None, :, 0], y[:, None] - avoid[None, :, 1]), axis=1) >= avoid_radius
