@@ -11,6 +11,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
+from mbot_slam_navigation.map_stats import free_at
 from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupancy_to_image, save_map
 from mbot_slam_navigation.nav.frontiers import Grid
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
@@ -47,11 +48,7 @@ def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robo
     rows, cols = np.nonzero(mask)
     x = origin[0] + (cols + 0.5) * m.resolution
     y = origin[1] + (rows + 0.5) * m.resolution
-    mr, mc = m.cell_of(x, y)
-    inside = m.inside(mr, mc)
-    seen = np.zeros(len(x), bool)
-    v = m.data[mr[inside], mc[inside]].astype(np.int16)
-    seen[inside] = (v >= 0) & (v <= SAVER_FREE)
+    seen = free_at(m.data, m.resolution, m.origin, x, y, SAVER_FREE)
     orows, ocols = np.nonzero(m.data.astype(np.int16) >= SAVER_OCCUPIED)
     wx, wy = m.centre_of(orows, ocols)
     d = distance_to_surfaces(world, np.column_stack([wx, wy])) if len(wx) else np.zeros(0)

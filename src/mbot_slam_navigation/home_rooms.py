@@ -6,6 +6,7 @@ from typing import Dict
 
 import numpy as np
 
+from mbot_slam_navigation.map_stats import free_at
 from mbot_slam_navigation.maps.map_io import SAVER_FREE, LoadedMap
 
 
@@ -39,11 +40,7 @@ def room_coverage(m: LoadedMap, truth: np.ndarray, truth_origin, truth_resolutio
     xs = truth_origin[0] + (np.arange(w) + 0.5) * truth_resolution
     ys = truth_origin[1] + (np.arange(h) + 0.5) * truth_resolution
     gx, gy = np.meshgrid(xs, ys)
-    col = np.floor((gx - m.origin[0]) / m.resolution).astype(int)
-    row = np.floor((gy - m.origin[1]) / m.resolution).astype(int)
-    inside = (col >= 0) & (col < m.data.shape[1]) & (row >= 0) & (row < m.data.shape[0])
-    seen_free = np.zeros_like(inside)
-    seen_free[inside] = (m.data[row[inside], col[inside]] >= 0) & (m.data[row[inside], col[inside]] <= SAVER_FREE)
+    seen_free = free_at(m.data, m.resolution, m.origin, gx, gy, SAVER_FREE)
     out = {}
     for r in HOME_ROOMS:
         floor = ((truth == 0) & (gx > r.xmin + margin) & (gx < r.xmax - margin)
