@@ -90,7 +90,6 @@ class Explore:
         self.path: List[Tuple[float, float]] = []
         self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
         self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
-        self.goals_failed = 0
         self.tf = tf2_ros.Buffer()
         self.tf_listener = tf2_ros.TransformListener(self.tf)
         rospy.Subscriber(map_topic, OccupancyGrid, self.on_map, queue_size=1, buff_size=2 ** 24)
@@ -122,6 +121,9 @@ class Explore:
             return None
         q = t.transform.rotation
         return t.transform.translation.x, t.transform.translation.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
+
+    def goals_failed(self) -> int:
+        return sum(not reached for _, _, reached in self.goals)
 
     def clear_costmaps(self) -> None:
         """move_base's ~clear_costmaps, as its recoveries use it; failures are only logged."""
@@ -176,7 +178,6 @@ class Explore:
             self.state.reached(now)
         else:
             self.goals.append((gx, gy, False))
-            self.goals_failed += 1
             rospy.logwarn('explore: move_base gave up on (%.2f, %.2f): %s; blacklisted for %.0f s', gx, gy,
                           self.move_base.get_goal_status_text(), self.state.blacklist_timeout)
             self.state.fail(now)
@@ -205,7 +206,6 @@ class Explore:
             self.finish_goal(now)
             goal = self.state.goal
             if self.state.stuck(now, pose[:2]):
-                self.goals_failed += 1
                 self.goals.append((goal.goal[0], goal.goal[1], False))
                 rospy.logwarn('explore: no progress for %.0f s; goal blacklisted', self.state.progress_timeout)
                 self.move_base.cancel_goal()
@@ -239,7 +239,7 @@ class Explore:
                 next_print = now + self.progress_period
                 print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
                       'wall' % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
-                                self.goals_failed, now, time.monotonic() - wall0), flush=True)
+                                self.goals_failed(), now, time.monotonic() - wall0), flush=True)
             rospy.sleep(self.period)
         if rospy.is_shutdown():
             return
@@ -264,7 +264,7 @@ class Explore:
             'wall_time_s': round(time.monotonic() - wall0, 1),
             'distance_m': round(distance, 2),
             'goals_sent': self.state.goals_chosen,
-            'goals_failed': self.goals_failed,
+            'goals_failed': self.goals_failed(),
             'collisions': self.collisions,
         }
         if self.report_dir and self.map is not None:

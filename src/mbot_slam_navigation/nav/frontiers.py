@@ -165,7 +165,6 @@ class ExploreState:
     blacklist_radius: float = 0.6     # [m] around a failed or visited goal
     hysteresis: float = 1.0           # [cost] a new frontier must beat the current goal's by this
     goal: Optional[Frontier] = None
-    goal_cost: float = math.inf
     progress_at: Tuple[float, float] = (math.nan, math.nan)
     progress_time: float = 0.0
     blacklist: List[Blacklisted] = field(default_factory=list)
@@ -179,8 +178,8 @@ class ExploreState:
         return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
 
     def choose(self, now: float, frontiers: List[Frontier], robot: Tuple[float, float]) -> Optional[Frontier]:
-        """The frontier to head for (a new goal to send), or None to keep the current goal (or, when
-        there is none and `frontiers` is empty, to stop: see done())."""
+        """The frontier to head for (a goal to send), or None to keep the current goal; with no
+        frontiers the current goal's place counts as visited and there is no goal."""
         if not frontiers:
             self.reached(now)
             return None
@@ -204,7 +203,7 @@ class ExploreState:
                 # the old goal): follow it without counting a new goal.
                 self.goal = current[0]
                 return current[0]
-        self.goal, self.goal_cost = best, best.cost
+        self.goal = best
         self.goals_chosen += 1
         self.progress_at, self.progress_time = robot, now
         return best

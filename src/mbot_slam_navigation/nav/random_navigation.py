@@ -149,16 +149,20 @@ def next_round(rng: random.Random, names: Sequence[str], last: str) -> List[str]
 @dataclass
 class Tally:
     """What the tutorial logs after every goal, and the summary at the end."""
-    goals: int = 0
-    successes: int = 0
     distance: float = 0.0             # [m] straight lines to the goals reached, as the tutorial counts
     outcomes: Dict[str, List[str]] = field(default_factory=dict)  # location -> state names
 
+    @property
+    def goals(self) -> int:
+        return sum(len(states) for states in self.outcomes.values())
+
+    @property
+    def successes(self) -> int:
+        return sum(s == 'SUCCEEDED' for states in self.outcomes.values() for s in states)
+
     def record(self, location: str, state: str, distance: float) -> None:
-        self.goals += 1
         self.outcomes.setdefault(location, []).append(state)
         if state == 'SUCCEEDED':
-            self.successes += 1
             self.distance += distance
 
     def success_line(self) -> str:
