@@ -15,6 +15,7 @@
 #include "mbot_slam_navigation/core/map_image.h"
 #include "mbot_slam_navigation/core/obstacle_layer.h"
 #include "mbot_slam_navigation/core/global_planner.h"
+#include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
@@ -341,12 +342,12 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("motion", &RbpfParams::motion)
       .def_readwrite("matcher", &RbpfParams::matcher)
       .def("validate", &RbpfParams::validate);
-  using mbot::core::RbpfSlam;
-  py::class_<RbpfSlam>(m, "_RbpfSlam")
-      .def(py::init<const RbpfParams&>())
+  // Both backends share the SlamBackend methods, bound once on the base class.
+  using mbot::core::SlamBackend;
+  py::class_<SlamBackend>(m, "_SlamBackend")
       .def(
           "process_scan",
-          [](RbpfSlam& s, const Eigen::Vector3d& odom, double angle_min, double angle_increment, double range_min,
+          [](SlamBackend& s, const Eigen::Vector3d& odom, double angle_min, double angle_increment, double range_min,
              double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,
              double time) {
             const LaserScan scan = toScan(angle_min, angle_increment, range_min, range_max, ranges);
@@ -355,10 +356,10 @@ PYBIND11_MODULE(_core, m) {
           },
           py::arg("odom"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("range_min"),
           py::arg("range_max"), py::arg("ranges"), py::arg("time"))
-      .def("current_pose", &RbpfSlam::currentPose)
-      .def("best_trajectory",
-           [](const RbpfSlam& s) {
-             const auto traj = s.bestTrajectory();
+      .def("current_pose", &SlamBackend::currentPose)
+      .def("trajectory",
+           [](const SlamBackend& s) {
+             const auto traj = s.trajectory();
              py::array_t<double> out({static_cast<py::ssize_t>(traj.size()), static_cast<py::ssize_t>(7)});
              auto o = out.mutable_unchecked<2>();
              for (std::size_t i = 0; i < traj.size(); ++i) {
@@ -370,16 +371,23 @@ PYBIND11_MODULE(_core, m) {
              }
              return out;
            })
-      .def("best_map",
-           [](const RbpfSlam& s, double occ_thresh) {
-             const auto img = s.best().map.toOccupancy(occ_thresh);
+      .def("occupancy",
+           [](const SlamBackend& s, double occ_thresh) {
+             mbot::core::OccupancyImage img;
+             {
+               py::gil_scoped_release release;
+               img = s.occupancy(occ_thresh);
+             }
              py::array_t<int8_t> data({img.height, img.width});
              std::copy(img.data.begin(), img.data.end(), data.mutable_data());
              return py::make_tuple(data, img.origin, img.resolution);
            },
            py::arg("occ_thresh") = 0.25)
+      .def_property_readonly("updates", &SlamBackend::updates);
+  using mbot::core::RbpfSlam;
+  py::class_<RbpfSlam, SlamBackend>(m, "_RbpfSlam")
+      .def(py::init<const RbpfParams&>())
       .def("pose_entropy", &RbpfSlam::poseEntropy)
-      .def_property_readonly("updates", &RbpfSlam::updates)
       .def_property_readonly("resamples", &RbpfSlam::resamples)
       .def_property_readonly("last_neff", &RbpfSlam::lastNeff)
       .def("particle_poses", [](const RbpfSlam& s) {
@@ -397,6 +405,76 @@ PYBIND11_MODULE(_core, m) {
         }
         return py::make_tuple(distinct.size() * mbot::core::SlamGrid::kPatchBytes,
                               referenced * mbot::core::SlamGrid::kPatchBytes);
+      });
+  using mbot::core::GraphSlamParams;
+  py::class_<GraphSlamParams>(m, "_GraphSlamParams")
+      .def(py::init<>())
+      .def_readwrite("linear_update", &GraphSlamParams::linear_update)
+      .def_readwrite("angular_update", &GraphSlamParams::angular_update)
+      .def_readwrite("temporal_update", &GraphSlamParams::temporal_update)
+      .def_readwrite("delta", &GraphSlamParams::delta)
+      .def_readwrite("xmin", &GraphSlamParams::xmin)
+      .def_readwrite("ymin", &GraphSlamParams::ymin)
+      .def_readwrite("xmax", &GraphSlamParams::xmax)
+      .def_readwrite("ymax", &GraphSlamParams::ymax)
+      .def_readwrite("matcher", &GraphSlamParams::matcher)
+      .def_readwrite("match_max_range", &GraphSlamParams::match_max_range)
+      .def_readwrite("match_sigma", &GraphSlamParams::match_sigma)
+      .def_readwrite("local_map_nodes", &GraphSlamParams::local_map_nodes)
+      .def_readwrite("local_search_window", &GraphSlamParams::local_search_window)
+      .def_readwrite("local_search_angle", &GraphSlamParams::local_search_angle)
+      .def_readwrite("local_min_score", &GraphSlamParams::local_min_score)
+      .def_readwrite("submap_nodes", &GraphSlamParams::submap_nodes)
+      .def_readwrite("loop_search_radius", &GraphSlamParams::loop_search_radius)
+      .def_readwrite("loop_search_growth", &GraphSlamParams::loop_search_growth)
+      .def_readwrite("loop_search_max_radius", &GraphSlamParams::loop_search_max_radius)
+      .def_readwrite("loop_search_angle", &GraphSlamParams::loop_search_angle)
+      .def_readwrite("loop_min_response", &GraphSlamParams::loop_min_response)
+      .def_readwrite("loop_ambiguity", &GraphSlamParams::loop_ambiguity)
+      .def_readwrite("loop_candidates", &GraphSlamParams::loop_candidates)
+      .def_readwrite("loop_reject_chi2", &GraphSlamParams::loop_reject_chi2)
+      .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)
+      .def_readwrite("edge_sigma_theta", &GraphSlamParams::edge_sigma_theta)
+      .def_readwrite("cauchy_scale", &GraphSlamParams::cauchy_scale)
+      .def_readwrite("background", &GraphSlamParams::background)
+      .def("validate", &GraphSlamParams::validate);
+  using mbot::core::GraphSlam;
+  py::class_<GraphSlam, SlamBackend>(m, "_GraphSlam")
+      .def(py::init<const GraphSlamParams&>())
+      .def("flush", &GraphSlam::flush, py::call_guard<py::gil_scoped_release>())
+      .def("stats",
+           [](const GraphSlam& s) {
+             const auto st = s.stats();
+             py::dict d;
+             d["nodes"] = st.nodes;
+             d["local_match_failures"] = st.local_match_failures;
+             d["loop_attempts"] = st.loop_attempts;
+             d["loop_closures"] = st.loop_closures;
+             d["loop_rejected_ambiguous"] = st.loop_rejected_ambiguous;
+             d["loop_rejected_inconsistent"] = st.loop_rejected_inconsistent;
+             d["optimizations"] = st.optimizations;
+             d["last_optimization_ms"] = st.last_optimization_ms;
+             d["search_radius_m"] = st.search_radius_m;
+             return d;
+           })
+      .def("scan_poses",
+           [](const GraphSlam& s) {
+             const auto poses = s.scanPoses();
+             py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), static_cast<py::ssize_t>(4)});
+             auto o = out.mutable_unchecked<2>();
+             for (std::size_t i = 0; i < poses.size(); ++i) {
+               o(i, 0) = poses[i].first;
+               for (int k = 0; k < 3; ++k) o(i, 1 + k) = poses[i].second[k];
+             }
+             return out;
+           })
+      .def("closures", [](const GraphSlam& s) {
+        // (from, to) node indices of the loop-closure edges
+        std::vector<std::pair<int, int>> out;
+        for (const auto& e : s.edges()) {
+          if (e.robust) out.emplace_back(e.from, e.to);
+        }
+        return out;
       });
 
   // --- Costmaps ----------------------------------------------------------------------------------

@@ -166,7 +166,7 @@ Eigen::Vector3d RbpfSlam::currentPose() const {
   return composePose(b.node->pose, relativePose(b.node->odom, last_odom_));
 }
 
-std::vector<TrajectoryNode> RbpfSlam::bestTrajectory() const {
+std::vector<TrajectoryNode> RbpfSlam::trajectory() const {
   std::vector<TrajectoryNode> out;
   for (const TrajectoryNode* n = best().node.get(); n; n = n->parent.get()) out.push_back(*n);
   std::reverse(out.begin(), out.end());

@@ -1,10 +1,13 @@
-// slam_gmapping: the gmapping node's interface on this package's C++ RBPF (core/rbpf_slam.h).
+// slam_gmapping: the gmapping node's interface on this package's C++ SLAM backends: `~backend`
+// graph (default; core/graph_slam.h, pose graph with loop closure) or rbpf (core/rbpf_slam.h,
+// gmapping's particle filter).
 //
 // Subscribes `scan` (with tf from its frame to ~base_frame and from ~base_frame to ~odom_frame);
-// publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy`; serves
-// `dynamic_map`; broadcasts ~map_frame -> ~odom_frame every ~transform_publish_period. Parameters
-// have gmapping's names and defaults; an unknown private parameter gets a warning naming the
-// nearest known one (the tutorial's `base_link` means `base_frame`).
+// publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy` (rbpf only: the
+// graph has no particle cloud); serves `dynamic_map`; broadcasts ~map_frame -> ~odom_frame every
+// ~transform_publish_period. Parameters have gmapping's names and defaults, plus the graph's own
+// (graph_slam.h); an unknown private parameter gets a warning naming the nearest known one (the
+// tutorial's `base_link` means `base_frame`).
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -22,6 +25,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "ros_conversions.h"
@@ -106,6 +110,31 @@ class SlamGmappingNode {
     int seed = 0;
     param("seed", seed);
     p.seed = static_cast<unsigned>(seed);
+    param("backend", backend_);
+    auto& g = graph_params_;
+    param("match_max_range", g.match_max_range);
+    param("match_sigma", g.match_sigma);
+    param("local_map_nodes", g.local_map_nodes);
+    param("local_search_window", g.local_search_window);
+    param("local_search_angle", g.local_search_angle);
+    param("local_min_score", g.local_min_score);
+    param("submap_nodes", g.submap_nodes);
+    param("loop_search_radius", g.loop_search_radius);
+    param("loop_search_growth", g.loop_search_growth);
+    param("loop_search_max_radius", g.loop_search_max_radius);
+    param("loop_search_angle", g.loop_search_angle);
+    param("loop_min_response", g.loop_min_response);
+    param("loop_ambiguity", g.loop_ambiguity);
+    param("loop_candidates", g.loop_candidates);
+    // The parameters both backends share have gmapping's names; read once above.
+    g.linear_update = p.linear_update;
+    g.angular_update = p.angular_update;
+    g.temporal_update = p.temporal_update;
+    g.delta = p.delta;
+    g.xmin = p.xmin;
+    g.ymin = p.ymin;
+    g.xmax = p.xmax;
+    g.ymax = p.ymax;
     for (std::string* frame : {&base_frame_, &odom_frame_, &map_frame_}) {
       if (!frame->empty() && (*frame)[0] == '/') {
         ROS_WARN("slam_gmapping: frame '%s' has a leading '/', which tf2 rejects; using '%s'", frame->c_str(),
@@ -161,29 +190,40 @@ class SlamGmappingNode {
       if (params.matcher.max_urange <= 0.0) params.matcher.max_urange = msg->range_max;
       try {
         std::lock_guard<std::mutex> lock(mutex_);
-        slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
+        if (backend_ == "rbpf") {
+          slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
+        } else if (backend_ == "graph") {
+          auto graph = graph_params_;
+          graph.matcher = params.matcher;
+          slam_ = std::make_unique<mbot::core::GraphSlam>(graph);
+        } else {
+          throw std::invalid_argument("backend must be 'graph' or 'rbpf', got '" + backend_ + "'");
+        }
       } catch (const std::invalid_argument& e) {
-        ROS_FATAL("slam_gmapping: bad parameter: %s", e.what());
+        ROS_FATAL("slam_gmapping: bad parameter ~%s", e.what());
         ros::shutdown();
         return;
       }
-      ROS_INFO("slam_gmapping: %d particles, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
-               params.particles, params.matcher.laser_pose.x(), params.matcher.laser_pose.y(),
-               params.matcher.laser_pose.z(), base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
+      ROS_INFO("slam_gmapping: %s backend%s, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
+               backend_.c_str(), backend_ == "rbpf" ? (" with " + std::to_string(params.particles) + " particles").c_str() : "",
+               params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
+               base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
     }
     bool updated;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
       if (updated) {
-        const Eigen::Vector3d pose = slam_->best().pose;
-        map_to_odom_ = composePose(pose, inversePose(odom));
+        // The graph's optimizer moves the current pose by its correction, and map -> odom with it.
+        map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
       }
     }
     if (!updated) return;
-    std_msgs::Float64 entropy;
-    entropy.data = slam_->poseEntropy();
-    entropy_pub_.publish(entropy);
+    if (const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get())) {
+      std_msgs::Float64 entropy;
+      entropy.data = rbpf->poseEntropy();
+      entropy_pub_.publish(entropy);
+    }
     if (last_map_update_.isZero() || (msg->header.stamp - last_map_update_).toSec() >= map_update_interval_) {
       publishMap(msg->header.stamp);
       last_map_update_ = msg->header.stamp;
@@ -195,7 +235,7 @@ class SlamGmappingNode {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!slam_) return;
-      mbot::ros_glue::toRos(slam_->best().map.toOccupancy(occ_thresh_), map);
+      mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), map);
     }
     map.header.frame_id = map_frame_;
     map.header.stamp = stamp;
@@ -248,6 +288,8 @@ class SlamGmappingNode {
   double map_update_interval_ = 5.0, transform_publish_period_ = 0.05, occ_thresh_ = 0.25, tf_delay_ = -1.0;
   int throttle_scans_ = 1;
   mbot::core::RbpfParams params_;
+  mbot::core::GraphSlamParams graph_params_;
+  std::string backend_ = "graph";
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
@@ -255,7 +297,7 @@ class SlamGmappingNode {
   ros::Subscriber scan_sub_;
   ros::ServiceServer map_srv_;
   std::mutex mutex_, map_mutex_;
-  std::unique_ptr<mbot::core::RbpfSlam> slam_;
+  std::unique_ptr<mbot::core::SlamBackend> slam_;
   Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
   nav_msgs::OccupancyGrid last_map_;
   ros::Time last_stamp_, last_map_update_;

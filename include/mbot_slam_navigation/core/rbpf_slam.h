@@ -22,6 +22,7 @@
 
 #include "mbot_slam_navigation/core/motion_model.h"
 #include "mbot_slam_navigation/core/scan_matcher.h"
+#include "mbot_slam_navigation/core/slam_backend.h"
 #include "mbot_slam_navigation/core/slam_grid.h"
 
 namespace mbot {
@@ -45,14 +46,6 @@ struct RbpfParams {
   void validate() const;  ///< std::invalid_argument naming the gmapping parameter
 };
 
-/// One node of a particle's trajectory (shared by the descendants of the particle that made it).
-struct TrajectoryNode {
-  Eigen::Vector3d pose;       ///< base in map
-  Eigen::Vector3d odom;       ///< base in odom at the same time
-  double time_s;
-  std::shared_ptr<const TrajectoryNode> parent;
-};
-
 struct Particle {
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();
   double log_weight = 0.0;     ///< since the last resampling
@@ -66,25 +59,27 @@ struct Particle {
 /// order. O(n). Any particle with weight above 1/n is chosen at least once.
 std::vector<int> lowVarianceResample(const std::vector<double>& weights, double offset);
 
-class RbpfSlam {
+class RbpfSlam : public SlamBackend {
  public:
   explicit RbpfSlam(const RbpfParams& params);
 
   /// Feeds one scan with the odometry pose at its time. Returns true when the scan updated the
   /// filter (motion since the last update exceeded the thresholds, or the first scan).
-  bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s);
+  bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s) override;
 
   int bestIndex() const;
   const Particle& best() const { return particles_[bestIndex()]; }
   const std::vector<Particle>& particles() const { return particles_; }
   /// The best particle's pose composed with odometry since its last update: base in map now.
-  Eigen::Vector3d currentPose() const;
+  Eigen::Vector3d currentPose() const override;
   /// The best particle's trajectory, oldest first.
-  std::vector<TrajectoryNode> bestTrajectory() const;
+  std::vector<TrajectoryNode> trajectory() const override;
+  /// The best particle's map.
+  OccupancyImage occupancy(double occ_thresh) const override { return best().map.toOccupancy(occ_thresh); }
   /// Entropy of the particles' pose distribution (gaussian fit) [nats].
   double poseEntropy() const;
   double lastNeff() const { return last_neff_; }
-  int updates() const { return updates_; }
+  int updates() const override { return updates_; }
   int resamples() const { return resamples_; }
   const RbpfParams& params() const { return params_; }
 

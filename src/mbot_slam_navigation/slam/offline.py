@@ -1,8 +1,9 @@
 """slam_offline: the SLAM core on a CARMEN log (or a rosbag), as fast as the CPU allows.
 
-Writes OUT.traj (`t x y theta` per scan: the best particle's trajectory, with odometry between its
+Writes OUT.traj (`t x y theta` per scan: the estimated trajectory, with odometry between its map
 updates), OUT.pgm/OUT.yaml (map_server format) and OUT.timing.json (CPU seconds, scans, updates).
-Usage: slam_offline LOG [-o OUT] [--relations FILE] [--param name=value ...] [--quiet]
+Usage: slam_offline LOG [-o OUT] [--backend graph|rbpf] [--relations FILE] [--param name=value ...]
+[--quiet]
 """
 import argparse
 import json
@@ -14,7 +15,7 @@ import numpy as np
 
 from mbot_slam_navigation.maps.map_io import save_map
 from mbot_slam_navigation.slam.carmen import read_log
-from mbot_slam_navigation.slam.rbpf import GMAPPING_DEFAULTS, RbpfSlam
+from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, make_slam
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
 from mbot_slam_navigation.transforms import compose2d, quaternion_to_yaw, relative2d
 
@@ -28,6 +29,16 @@ def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
         node_pose, node_odom = trajectory[k, 1:4], trajectory[k, 4:7]
         out[i] = compose2d(node_pose, relative2d(node_odom, scan.odom))
     return out
+
+
+def estimated_poses(slam, scans) -> np.ndarray:
+    """The backend's pose at every scan: the graph's tracked scan poses, or (the particle filter)
+    its trajectory moved on by odometry."""
+    if hasattr(slam, 'scan_poses'):
+        tracked = slam.scan_poses()
+        if len(tracked) == len(scans):
+            return tracked[:, 1:4]
+    return per_scan_poses(slam.trajectory(), scans)
 
 
 def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
@@ -68,9 +79,10 @@ class Progress:
         sys.stderr.flush()
 
 
-def run(scans, params, progress=True):
-    """Runs the filter over the scans; returns (slam, cpu_seconds)."""
-    slam = RbpfSlam(laser_pose=scans[0].laser_pose, **params)
+def run(scans, params, progress=True, backend=DEFAULT_BACKEND):
+    """Runs a backend over the scans; returns (slam, cpu_seconds). The CPU time is the process's,
+    so it counts every thread (the graph backend runs synchronously here, on one core)."""
+    slam = make_slam(backend, params, scans[0].laser_pose)
     bar = Progress(len(scans), progress)
     cpu = 0.0
     for i, s in enumerate(scans):
@@ -78,14 +90,18 @@ def run(scans, params, progress=True):
         slam.process_scan(s.odom, s.angle_min, s.angle_increment, 0.0, params.get('maxRange', 80.0), s.ranges, s.time)
         cpu += time.process_time() - c0
         bar.update(i + 1, slam.updates)
+    c0 = time.process_time()
+    slam.finish()
+    cpu += time.process_time() - c0
     return slam, cpu
 
 
 def parse_param(text):
     name, _, value = text.partition('=')
-    if name not in GMAPPING_DEFAULTS or not value:
-        raise argparse.ArgumentTypeError('--param takes name=value with a slam_gmapping name, got "%s"' % text)
-    return name, float(value)
+    try:
+        return name, float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError('--param takes name=value with a number, got "%s"' % text) from None
 
 
 def main(argv=None):
@@ -93,6 +109,7 @@ def main(argv=None):
     ap.add_argument('log', help='CARMEN log (.clf, .log, optionally .bz2) or rosbag (.bag)')
     ap.add_argument('-o', '--out', help='output base name (default: the log name without extension)')
     ap.add_argument('--relations', help='relations file: print the Kümmerle et al. error')
+    ap.add_argument('--backend', choices=BACKENDS, default=DEFAULT_BACKEND, help='SLAM backend (default %(default)s)')
     ap.add_argument('--param', action='append', type=parse_param, default=[], help='slam_gmapping name=value')
     ap.add_argument('--quiet', action='store_true', help='no progress bar')
     args = ap.parse_args(argv)
@@ -100,15 +117,18 @@ def main(argv=None):
         ap.error('log file %s does not exist' % args.log)
     scans = read_rosbag(args.log) if args.log.endswith('.bag') else read_log(args.log)
     params = dict(args.param)
-    slam, cpu = run(scans, params, progress=not args.quiet)
+    try:
+        slam, cpu = run(scans, params, progress=not args.quiet, backend=args.backend)
+    except KeyError as e:
+        ap.error(e.args[0])
     out = args.out or os.path.basename(args.log).split('.')[0]
-    poses = per_scan_poses(slam.best_trajectory(), scans)
+    poses = estimated_poses(slam, scans)
     times = np.array([s.time for s in scans])
     np.savetxt(out + '.traj', np.column_stack([times, poses]), fmt='%.6f', header='t x y theta')
-    data, origin, res = slam.best_map()
+    data, origin, res = slam.occupancy()
     save_map(out, data, res, (origin[0], origin[1], 0.0))
     duration = scans[-1].time - scans[0].time
-    summary = dict(log=args.log, scans=len(scans), updates=slam.updates, resamples=slam.resamples,
+    summary = dict(log=args.log, backend=args.backend, scans=len(scans), updates=slam.updates,
                    cpu_seconds=cpu, log_duration_s=duration, params=params)
     if args.relations:
         e = evaluate(times, poses, read_relations(args.relations))

@@ -1,0 +1,96 @@
+// Correlative scan matching for the pose-graph SLAM backend.
+//
+// A LikelihoodGrid holds, for every cell, how well a laser end point there would agree with a set
+// of reference points (earlier scans): exp(-d^2 / (2 sigma^2)) of the distance d to the nearest
+// reference point, stored as 0..255 (Olson, "Real-Time Correlative Scan Matching", ICRA 2009).
+// The score of a pose is the mean of that value over the scan's points, in [0, 1].
+//
+// matchBranchAndBound() finds the best-scoring pose in a window (x, y within +-linear, yaw within
+// +-angular of an initial pose) exactly, at the grid's resolution and an angular step that moves
+// the farthest point by at most one cell, without visiting every pose: it scores coarse blocks of
+// translations on max-pooled copies of the grid (an upper bound of every pose in the block) and
+// only descends into blocks whose bound beats the best pose found so far (Hess, Kohler, Rapp,
+// Andor, "Real-Time Loop Closure in 2D LIDAR SLAM", ICRA 2016, section V). refine() then climbs the
+// bilinearly interpolated score below the grid's resolution.
+//
+// Frames: the grid and every pose live in one "reference" frame (the map frame for local
+// matching, a submap's anchor node for loop closure); scan points are in the robot base frame.
+// Units: metres and radians.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/laser_scan.h"
+
+namespace mbot {
+namespace core {
+
+class LikelihoodGrid {
+ public:
+  /// A grid covering `points` (reference frame, m) plus the kernel's reach, at `resolution_m`;
+  /// `sigma_m` is the kernel's standard deviation. Throws std::invalid_argument on bad values.
+  LikelihoodGrid(const std::vector<Eigen::Vector2d>& points, double resolution_m, double sigma_m);
+
+  double resolution() const { return resolution_; }
+  const Eigen::Vector2d& origin() const { return origin_; }  ///< corner of cell (0, 0) [m]
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// Value 0..255 of cell (x, y); 0 outside.
+  int value(int x, int y) const {
+    return (x < 0 || y < 0 || x >= width_ || y >= height_) ? 0 : cells_[static_cast<std::size_t>(y) * width_ + x];
+  }
+  /// Bilinear interpolation of the values at a point of the reference frame, in [0, 1].
+  double interpolated(const Eigen::Vector2d& p) const;
+  /// Mean interpolated value of the points moved by `pose`, in [0, 1] (0 for no points).
+  double score(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose) const;
+
+  /// Max-pooled level h (h >= 1): value at (x, y) is the largest level-0 value in the block
+  /// [x, x + 2^h) x [y, y + 2^h); x and y may be as low as -(2^h - 1). Built on first use.
+  int pooled(int level, int x, int y) const;
+  /// Builds levels 1..levels-1 now (they are otherwise built lazily by the matcher).
+  void buildLevels(int levels) const;
+  /// Bytes held (base grid and pooled levels), for cache accounting.
+  std::size_t bytes() const;
+
+ private:
+  double resolution_;
+  Eigen::Vector2d origin_;
+  int width_ = 0, height_ = 0;
+  std::vector<uint8_t> cells_;
+  mutable std::vector<std::vector<uint8_t>> levels_;  // levels_[h - 1] is level h
+};
+
+struct MatchWindow {
+  double linear_m = 0.3;    ///< search x and y within +- this of the initial pose
+  double angular_rad = 0.3; ///< search yaw within +- this
+};
+
+struct MatchResult {
+  bool found = false;       ///< a pose scored above the minimum
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();
+  double score = 0.0;       ///< in [0, 1]
+};
+
+/// The end points of a scan usable for matching, in the robot base frame: finite returns within
+/// [range_min, min(max_range, range_max)), thinned to one point per `voxel_m` square (the first).
+std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
+                                         double voxel_m);
+
+/// The best pose of `points` (base frame) in `window` around `init`, if one scores above
+/// `min_score`. Candidates within `exclude_radius_m` / `exclude_angle_rad` of `exclude` (when
+/// `exclude` is given) are skipped: used to look for a second, different good match.
+MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                                const Eigen::Vector3d& init, const MatchWindow& window, double min_score,
+                                const Eigen::Vector3d* exclude = nullptr, double exclude_radius_m = 0.0,
+                                double exclude_angle_rad = 0.0);
+
+/// Hill-climbs the interpolated score from `init` with steps from half a cell and `angular_step`,
+/// halved `halvings` times; returns the pose and writes its score.
+Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score);
+
+}  // namespace core
+}  // namespace mbot

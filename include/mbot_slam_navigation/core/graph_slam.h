@@ -1,0 +1,178 @@
+// Pose-graph SLAM (the slam_gmapping node's `~backend: graph`), in the manner of Karto and
+// Cartographer:
+//
+// Local SLAM. Every scan is tracked: its pose, predicted by odometry from the previous scan's, is
+// corrected by correlative matching (branch and bound over a small window, then refinement; see
+// correlative_matcher.h) against a likelihood grid of the last `local_map_nodes` nodes' scans.
+// Every linearUpdate metres, angularUpdate radians or temporalUpdate seconds of odometry the
+// tracked scan becomes a node, joined by an edge to the previous node, and the local map is rebuilt.
+//
+// Loop closure. Every `submap_nodes` nodes form a submap: their scans in the frame of the first
+// (the anchor), as a likelihood grid that is kept. Each new node is matched against the finished
+// submaps that have a node within the search radius of its estimate; the radius grows with the
+// distance travelled since the last accepted closure (odometry drift) from loop_search_radius to
+// loop_search_max_radius, and the window of the branch-and-bound search is that radius. A match
+// becomes an edge (anchor -> node) only if its response reaches loop_min_response and it is not
+// ambiguous: no other pose at least 0.3 m or 0.1 rad away scores within loop_ambiguity of it
+// (a corridor, a row of doors).
+//
+// Optimization. After new closures the graph is solved (pose_graph.h): first with a wide Cauchy
+// loss, then with the nominal one, so that consistent closures pull fully and a wrong one is
+// down-weighted; a closure still inconsistent with the rest afterwards (Mahalanobis error above
+// loop_reject_chi2) is removed and the graph solved again. This runs in a background thread
+// (`background`), so processScan never waits for it; nodes added meanwhile move with the last
+// optimized node.
+//
+// Map. A gmapping counting grid (slam_grid.h) of every node's scan at its optimized pose. Nodes
+// are added as they come; the grid is rebuilt from all nodes only after an optimization moved some
+// node by more than half a cell or 0.5 degree.
+//
+// Frames and units: as slam_backend.h.
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/correlative_matcher.h"
+#include "mbot_slam_navigation/core/pose_graph.h"
+#include "mbot_slam_navigation/core/scan_matcher.h"
+#include "mbot_slam_navigation/core/slam_backend.h"
+#include "mbot_slam_navigation/core/slam_grid.h"
+
+namespace mbot {
+namespace core {
+
+struct GraphSlamParams {
+  double linear_update = 1.0;       ///< [m] `linearUpdate`
+  double angular_update = 0.5;      ///< [rad] `angularUpdate`
+  double temporal_update = -1.0;    ///< [s] `temporalUpdate`; < 0 disables
+  double delta = 0.05;              ///< [m] map resolution (`delta`), also the matching resolution
+  double xmin = -100, ymin = -100, xmax = 100, ymax = 100;  ///< [m] initial map extent (grows)
+  /// Map registration: laser pose in the base frame, `maxUrange`, `maxRange`.
+  ScanMatcherParams matcher;
+
+  double match_max_range = 30.0;    ///< [m] returns farther than this are not matched (`~match_max_range`)
+  double match_sigma = 0.05;        ///< [m] likelihood kernel (`~match_sigma`)
+  int local_map_nodes = 20;         ///< nodes in the local map (`~local_map_nodes`)
+  double local_search_window = 0.15; ///< [m] +- x, y around the odometry prediction (`~local_search_window`)
+  double local_search_angle = 0.15; ///< [rad] +- yaw (`~local_search_angle`)
+  double local_min_score = 0.25;    ///< below: keep the odometry prediction (`~local_min_score`)
+  int submap_nodes = 10;            ///< nodes per loop-closure submap (`~submap_nodes`)
+  double loop_search_radius = 2.0;  ///< [m] search radius right after a closure (`~loop_search_radius`)
+  double loop_search_growth = 0.05; ///< [m per m travelled] radius growth (`~loop_search_growth`)
+  double loop_search_max_radius = 6.0;  ///< [m] (`~loop_search_max_radius`)
+  double loop_search_angle = 0.35;  ///< [rad] +- yaw of the loop search (`~loop_search_angle`)
+  double loop_min_response = 0.55;  ///< mean likelihood a closure must reach (`~loop_min_response`)
+  double loop_ambiguity = 0.9;      ///< a second pose scoring this share of the best rejects it (`~loop_ambiguity`)
+  int loop_candidates = 3;          ///< nearest submaps tried per node (`~loop_candidates`)
+  double loop_reject_chi2 = 50.0;   ///< closures above this error after optimizing are removed
+  double edge_sigma_xy = 0.03;      ///< [m] standard deviation of an edge's translation
+  double edge_sigma_theta = 0.01;   ///< [rad] and of its rotation
+  double cauchy_scale = 3.0;        ///< Cauchy loss scale of closures, in standard deviations
+  bool background = true;           ///< optimize in a background thread (false: inline, deterministic)
+  /// Throws std::invalid_argument naming the ROS parameter when a value is unusable.
+  void validate() const;
+};
+
+struct GraphSlamStats {
+  int nodes = 0;
+  int local_match_failures = 0;     ///< nodes left at the odometry prediction
+  int loop_attempts = 0;            ///< submap matches tried
+  int loop_closures = 0;            ///< closure edges in the graph
+  int loop_rejected_ambiguous = 0;
+  int loop_rejected_inconsistent = 0;  ///< removed after optimization
+  int optimizations = 0;
+  double last_optimization_ms = 0.0;
+  double search_radius_m = 0.0;     ///< current loop search radius
+};
+
+class GraphSlam : public SlamBackend {
+ public:
+  explicit GraphSlam(const GraphSlamParams& params);
+  ~GraphSlam() override;
+  GraphSlam(const GraphSlam&) = delete;
+  GraphSlam& operator=(const GraphSlam&) = delete;
+
+  bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s) override;
+  Eigen::Vector3d currentPose() const override;
+  std::vector<TrajectoryNode> trajectory() const override;
+  OccupancyImage occupancy(double occ_thresh) const override;
+  int updates() const override;
+
+  /// Waits until the background thread has searched every node for closures and the graph is
+  /// optimized (for offline runs and tests; the node never calls it).
+  void flush();
+  GraphSlamStats stats() const;
+  /// Every tracked scan's pose (time [s], base in map), each moved with the node before it by every
+  /// optimization since: a finer trajectory than the nodes alone.
+  std::vector<std::pair<double, Eigen::Vector3d>> scanPoses() const;
+  /// The graph's edges (chain and closures), for drawing and tests.
+  std::vector<PoseGraphEdge> edges() const;
+  const GraphSlamParams& params() const { return params_; }
+
+ private:
+  struct Node {
+    Eigen::Vector3d pose;   // base in map, optimized
+    Eigen::Vector3d odom;   // base in odom
+    double time_s;
+    double travelled_m;     // odometry path length from the first node
+    std::shared_ptr<const LaserScan> scan;
+    std::shared_ptr<const std::vector<Eigen::Vector2d>> points;  // match points, base frame
+  };
+  struct TrackedScan {
+    double time_s;
+    int node;                // the last node before it (or itself)
+    Eigen::Vector3d offset;  // its pose in that node's frame
+  };
+  struct Submap {
+    int first, last;        // node indices [first, last]; first is the anchor
+    std::shared_ptr<const LikelihoodGrid> grid;  // in the anchor's frame
+  };
+
+  Eigen::Vector3d matchLocally(const Eigen::Vector3d& predicted, const std::vector<Eigen::Vector2d>& points);
+  void rebuildLocalMapLocked();  // mutex_ held
+  void backgroundLoop();
+  /// Closure search for one node and the submap that it completes; returns true if edges were added.
+  bool searchClosures(int node);
+  void buildSubmap(int first, int last);
+  void optimize();
+  Eigen::Matrix3d edgeInformation(double scale) const;
+
+  GraphSlamParams params_;
+  ScanMatcher registrar_;  // map registration (gmapping's beam rules)
+
+  mutable std::mutex mutex_;  // nodes_, edges_, submaps_, stats_, last_odom_
+  std::condition_variable work_cv_, idle_cv_;
+  std::vector<Node> nodes_;
+  std::vector<PoseGraphEdge> edges_;
+  std::vector<Submap> submaps_;
+  std::vector<TrackedScan> scans_;
+  std::deque<int> pending_;  // nodes not yet searched for closures
+  bool busy_ = false, stop_ = false;
+  GraphSlamStats stats_;
+  double last_closure_travelled_ = 0.0;
+
+  Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero();
+  // Scan tracking (processScan's thread): the local map, the last node's pose when it was built
+  // (its frame), and the latest scan's matched pose in that frame with its odometry.
+  std::unique_ptr<LikelihoodGrid> local_map_;
+  Eigen::Vector3d local_anchor_ = Eigen::Vector3d::Zero(), track_pose_ = Eigen::Vector3d::Zero(),
+                  track_odom_ = Eigen::Vector3d::Zero();
+  double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0, travelled_ = 0.0;
+
+  mutable std::mutex map_mutex_;  // the map cache
+  mutable SlamGrid map_;
+  mutable int map_nodes_ = 0;     // nodes registered in map_
+  mutable bool map_dirty_ = false;
+
+  std::thread worker_;
+};
+
+}  // namespace core
+}  // namespace mbot

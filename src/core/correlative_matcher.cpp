@@ -1,0 +1,270 @@
+#include "mbot_slam_navigation/core/correlative_matcher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <unordered_set>
+
+#include "mbot_slam_navigation/core/cell.h"
+#include "mbot_slam_navigation/core/pose2d.h"
+
+namespace mbot {
+namespace core {
+
+LikelihoodGrid::LikelihoodGrid(const std::vector<Eigen::Vector2d>& points, double resolution_m, double sigma_m)
+    : resolution_(resolution_m) {
+  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) {
+    throw std::invalid_argument("LikelihoodGrid: resolution must be positive, got " + std::to_string(resolution_m));
+  }
+  if (!(sigma_m > 0.0) || !std::isfinite(sigma_m)) {
+    throw std::invalid_argument("LikelihoodGrid: sigma must be positive, got " + std::to_string(sigma_m));
+  }
+  const int r = static_cast<int>(std::ceil(3.0 * sigma_m / resolution_m));
+  Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = Eigen::Vector2d::Zero();
+  if (!points.empty()) {
+    lo = hi = points.front();
+    for (const auto& p : points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  // Whole cells, so that grids built from the same frame share cell boundaries.
+  origin_ = ((lo / resolution_).array().floor() - (r + 1)).matrix() * resolution_;
+  width_ = static_cast<int>(std::ceil((hi.x() - origin_.x()) / resolution_)) + r + 2;
+  height_ = static_cast<int>(std::ceil((hi.y() - origin_.y()) / resolution_)) + r + 2;
+  cells_.assign(static_cast<std::size_t>(width_) * height_, 0);
+  const double inv_two_sigma2 = 1.0 / (2.0 * sigma_m * sigma_m);
+  for (const auto& p : points) {
+    const Cell c = worldToCell(origin_, resolution_, p);
+    for (int dy = -r; dy <= r; ++dy) {
+      const int y = c.y + dy;
+      if (y < 0 || y >= height_) continue;
+      for (int dx = -r; dx <= r; ++dx) {
+        const int x = c.x + dx;
+        if (x < 0 || x >= width_) continue;
+        const Eigen::Vector2d d = cellCenter(origin_, resolution_, {x, y}) - p;
+        const auto v = static_cast<uint8_t>(std::lround(255.0 * std::exp(-d.squaredNorm() * inv_two_sigma2)));
+        uint8_t& cell = cells_[static_cast<std::size_t>(y) * width_ + x];
+        cell = std::max(cell, v);
+      }
+    }
+  }
+}
+
+double LikelihoodGrid::interpolated(const Eigen::Vector2d& p) const {
+  const double fx = (p.x() - origin_.x()) / resolution_ - 0.5, fy = (p.y() - origin_.y()) / resolution_ - 0.5;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  const double ax = fx - x0, ay = fy - y0;
+  const double v = (1 - ay) * ((1 - ax) * value(x0, y0) + ax * value(x0 + 1, y0)) +
+                   ay * ((1 - ax) * value(x0, y0 + 1) + ax * value(x0 + 1, y0 + 1));
+  return v / 255.0;
+}
+
+double LikelihoodGrid::score(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose) const {
+  if (points.empty()) return 0.0;
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  double sum = 0.0;
+  for (const auto& p : points) {
+    sum += interpolated({pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y()});
+  }
+  return sum / static_cast<double>(points.size());
+}
+
+int LikelihoodGrid::pooled(int level, int x, int y) const {
+  if (level == 0) return value(x, y);
+  const int pad = (1 << level) - 1;
+  const int w = width_ + pad, h = height_ + pad;
+  x += pad;
+  y += pad;
+  if (x < 0 || y < 0 || x >= w || y >= h) return 0;
+  return levels_[level - 1][static_cast<std::size_t>(y) * w + x];
+}
+
+void LikelihoodGrid::buildLevels(int levels) const {
+  for (int level = static_cast<int>(levels_.size()) + 1; level < levels; ++level) {
+    // max over [x, x + 2^h) = max of the two halves [x, x + s) and [x + s, x + 2s), s = 2^(h-1),
+    // in x and in y: four lookups in the level below.
+    const int s = 1 << (level - 1), pad = (1 << level) - 1;
+    const int w = width_ + pad, h = height_ + pad;
+    std::vector<uint8_t> out(static_cast<std::size_t>(w) * h);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const int gx = x - pad, gy = y - pad;
+        out[static_cast<std::size_t>(y) * w + x] = static_cast<uint8_t>(
+            std::max(std::max(pooled(level - 1, gx, gy), pooled(level - 1, gx + s, gy)),
+                     std::max(pooled(level - 1, gx, gy + s), pooled(level - 1, gx + s, gy + s))));
+      }
+    }
+    levels_.push_back(std::move(out));
+  }
+}
+
+std::size_t LikelihoodGrid::bytes() const {
+  std::size_t n = cells_.size();
+  for (const auto& l : levels_) n += l.size();
+  return n;
+}
+
+std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
+                                         double voxel_m) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(scan.ranges_m.size());
+  std::unordered_set<int64_t> seen;
+  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r <= 0.0 || r < scan.range_min_m || r >= limit) continue;
+    const double a = laser_pose.z() + scan.beamAngle(i);
+    const Eigen::Vector2d p = laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    if (voxel_m > 0.0) {
+      const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
+      if (!seen.insert((kx << 32) ^ (ky & 0xffffffff)).second) continue;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+namespace {
+struct Candidate {
+  int rotation;
+  int ox, oy;  // translation offset [cells]
+  int score;   // sum of (pooled) values
+};
+
+class BranchAndBound {
+ public:
+  BranchAndBound(const LikelihoodGrid& grid, int window_cells, const std::vector<std::vector<Cell>>& rotated)
+      : grid_(grid), wl_(window_cells), rotated_(rotated) {}
+
+  int scoreAt(const Candidate& c, int level) const {
+    int sum = 0;
+    for (const Cell& p : rotated_[c.rotation]) sum += grid_.pooled(level, p.x + c.ox, p.y + c.oy);
+    return sum;
+  }
+
+  // Depth first, best bound first; `best` is raised by every leaf that beats it, and a block whose
+  // bound does not beat it is never opened (its children can only score lower).
+  template <typename Accept>
+  void search(std::vector<Candidate>& candidates, int level, Candidate* best, const Accept& accept) const {
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+    for (const Candidate& c : candidates) {
+      if (c.score <= best->score) return;  // sorted: nothing after this can beat it either
+      if (level == 0) {
+        if (!accept(c)) continue;
+        *best = c;
+        return;
+      }
+      const int half = 1 << (level - 1);
+      std::vector<Candidate> children;
+      children.reserve(4);
+      for (int dx : {0, half}) {
+        for (int dy : {0, half}) {
+          Candidate child{c.rotation, c.ox + dx, c.oy + dy, 0};
+          if (child.ox > wl_ || child.oy > wl_) continue;
+          child.score = scoreAt(child, level - 1);
+          children.push_back(child);
+        }
+      }
+      search(children, level - 1, best, accept);
+    }
+  }
+
+ private:
+  const LikelihoodGrid& grid_;
+  int wl_;
+  const std::vector<std::vector<Cell>>& rotated_;
+};
+}  // namespace
+
+MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                                const Eigen::Vector3d& init, const MatchWindow& window, double min_score,
+                                const Eigen::Vector3d* exclude, double exclude_radius_m, double exclude_angle_rad) {
+  MatchResult result;
+  if (points.empty()) return result;
+  const double res = grid.resolution();
+  double dmax = 0.0;
+  for (const auto& p : points) dmax = std::max(dmax, p.norm());
+  // The angle that moves the farthest point by one cell (law of cosines).
+  const double astep = dmax > res ? std::acos(1.0 - res * res / (2.0 * dmax * dmax)) : std::max(window.angular_rad, 1e-3);
+  const int na = window.angular_rad > 0.0 ? static_cast<int>(std::ceil(window.angular_rad / astep)) : 0;
+  const int wl = std::max(0, static_cast<int>(std::ceil(window.linear_m / res)));
+  int top = 0;
+  while ((1 << top) < 2 * wl + 1 && top < 7) ++top;
+  grid.buildLevels(top + 1);
+
+  std::vector<std::vector<Cell>> rotated(2 * na + 1);
+  std::vector<double> angles(2 * na + 1);
+  for (int k = -na; k <= na; ++k) {
+    const double yaw = init.z() + k * astep;
+    angles[k + na] = yaw;
+    const double c = std::cos(yaw), s = std::sin(yaw);
+    auto& cells = rotated[k + na];
+    cells.reserve(points.size());
+    for (const auto& p : points) {
+      cells.push_back(worldToCell(grid.origin(), res, {init.x() + c * p.x() - s * p.y(), init.y() + s * p.x() + c * p.y()}));
+    }
+  }
+  const BranchAndBound bb(grid, wl, rotated);
+  std::vector<Candidate> candidates;
+  const int stride = 1 << top;
+  for (int r = 0; r <= 2 * na; ++r) {
+    for (int ox = -wl; ox <= wl; ox += stride) {
+      for (int oy = -wl; oy <= wl; oy += stride) {
+        Candidate c{r, ox, oy, 0};
+        c.score = bb.scoreAt(c, top);
+        candidates.push_back(c);
+      }
+    }
+  }
+  const double norm = 255.0 * static_cast<double>(points.size());
+  auto poseOf = [&](const Candidate& c) {
+    return Eigen::Vector3d(init.x() + c.ox * res, init.y() + c.oy * res, normalizeAngle(angles[c.rotation]));
+  };
+  auto accept = [&](const Candidate& c) {
+    if (!exclude) return true;
+    const Eigen::Vector3d p = poseOf(c);
+    return (p.head<2>() - exclude->head<2>()).norm() > exclude_radius_m ||
+           std::abs(normalizeAngle(p.z() - exclude->z())) > exclude_angle_rad;
+  };
+  // Leaves must beat min_score; scores are integers, so start just below it.
+  Candidate best{0, 0, 0, static_cast<int>(std::ceil(min_score * norm)) - 1};
+  bb.search(candidates, top, &best, accept);
+  if (best.score < static_cast<int>(std::ceil(min_score * norm)) || best.score <= 0) return result;
+  result.found = true;
+  result.pose = poseOf(best);
+  result.score = best.score / norm;
+  return result;
+}
+
+Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score) {
+  Eigen::Vector3d current = init;
+  double best = grid.score(points, current);
+  double l = 0.5 * grid.resolution(), a = angular_step_rad;
+  static const double kMoves[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (int round = 0; round <= halvings;) {
+    bool improved = false;
+    for (const auto& m : kMoves) {
+      const Eigen::Vector3d c(current.x() + m[0] * l, current.y() + m[1] * l, normalizeAngle(current.z() + m[2] * a));
+      const double s = grid.score(points, c);
+      if (s > best) {
+        best = s;
+        current = c;
+        improved = true;
+      }
+    }
+    if (!improved) {
+      l *= 0.5;
+      a *= 0.5;
+      ++round;
+    }
+  }
+  if (score) *score = best;
+  return current;
+}
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,397 @@
+#include "mbot_slam_navigation/core/graph_slam.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "mbot_slam_navigation/core/pose2d.h"
+
+namespace mbot {
+namespace core {
+
+void GraphSlamParams::validate() const {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument(std::string(name) + " must be positive, got " + std::to_string(v));
+  };
+  auto at_least = [](int v, int min, const char* name) {
+    if (v < min) throw std::invalid_argument(std::string(name) + " must be >= " + std::to_string(min) + ", got " + std::to_string(v));
+  };
+  if (!(linear_update >= 0.0)) throw std::invalid_argument("linearUpdate must be >= 0");
+  if (!(angular_update >= 0.0)) throw std::invalid_argument("angularUpdate must be >= 0");
+  positive(delta, "delta");
+  if (!(xmax > xmin && ymax > ymin)) throw std::invalid_argument("xmax/ymax must exceed xmin/ymin");
+  positive(match_max_range, "match_max_range");
+  positive(match_sigma, "match_sigma");
+  at_least(local_map_nodes, 1, "local_map_nodes");
+  if (!(local_search_window >= 0.0)) throw std::invalid_argument("local_search_window must be >= 0");
+  if (!(local_search_angle >= 0.0)) throw std::invalid_argument("local_search_angle must be >= 0");
+  if (!(local_min_score >= 0.0 && local_min_score <= 1.0)) throw std::invalid_argument("local_min_score must lie in [0, 1]");
+  at_least(submap_nodes, 1, "submap_nodes");
+  positive(loop_search_radius, "loop_search_radius");
+  if (!(loop_search_growth >= 0.0)) throw std::invalid_argument("loop_search_growth must be >= 0");
+  if (!(loop_search_max_radius >= loop_search_radius)) throw std::invalid_argument("loop_search_max_radius must be >= loop_search_radius");
+  if (!(loop_search_angle >= 0.0)) throw std::invalid_argument("loop_search_angle must be >= 0");
+  if (!(loop_min_response > 0.0 && loop_min_response <= 1.0)) throw std::invalid_argument("loop_min_response must lie in (0, 1]");
+  if (!(loop_ambiguity > 0.0 && loop_ambiguity <= 1.0)) throw std::invalid_argument("loop_ambiguity must lie in (0, 1]");
+  at_least(loop_candidates, 0, "loop_candidates");
+  positive(loop_reject_chi2, "loop_reject_chi2");
+  positive(edge_sigma_xy, "edge_sigma_xy");
+  positive(edge_sigma_theta, "edge_sigma_theta");
+  positive(cauchy_scale, "cauchy_scale");
+  matcher.validate();
+}
+
+GraphSlam::GraphSlam(const GraphSlamParams& params)
+    : params_((params.validate(), params)),
+      registrar_(params.matcher, params.delta),
+      map_({params.xmin, params.ymin}, {params.xmax, params.ymax}, params.delta) {
+  if (params_.background) worker_ = std::thread([this] { backgroundLoop(); });
+}
+
+GraphSlam::~GraphSlam() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  work_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+Eigen::Matrix3d GraphSlam::edgeInformation(double scale) const {
+  const double sxy = params_.edge_sigma_xy * scale, sth = params_.edge_sigma_theta * scale;
+  return Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
+}
+
+bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
+  bool first;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    first = nodes_.empty();
+    if (!first) {
+      const Eigen::Vector3d step = relativePose(last_odom_, odom);
+      linear_distance_ += step.head<2>().norm();
+      angular_distance_ += std::abs(step.z());
+      travelled_ += step.head<2>().norm();
+    }
+  }
+  const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
+  auto points = std::make_shared<const std::vector<Eigen::Vector2d>>(
+      matchPoints(scan, params_.matcher.laser_pose, reach, params_.delta));
+  if (!first) {
+    // Every scan is tracked against the local map, so that the next node's prediction is a few
+    // tenths of a second of odometry old, not a whole update's worth.
+    const Eigen::Vector3d predicted = composePose(track_pose_, relativePose(track_odom_, odom));
+    const Eigen::Vector3d tracked = matchLocally(predicted, *points);
+    std::lock_guard<std::mutex> lock(mutex_);
+    track_pose_ = tracked;
+    track_odom_ = odom;
+    scans_.push_back({time_s, static_cast<int>(nodes_.size()) - 1, relativePose(local_anchor_, tracked)});
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_odom_ = odom;
+  }
+  const bool due = first || linear_distance_ > params_.linear_update || angular_distance_ > params_.angular_update ||
+                   (params_.temporal_update >= 0.0 && time_s - last_update_time_ > params_.temporal_update);
+  if (!due) return false;
+  linear_distance_ = angular_distance_ = 0.0;
+  last_update_time_ = time_s;
+
+  int index;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    index = static_cast<int>(nodes_.size());
+    Eigen::Vector3d pose = odom;
+    if (!first) {
+      // The tracked pose is in the frame the local map was built in; the optimizer may have moved
+      // the last node since, and the new node moves with it.
+      const Eigen::Vector3d z = relativePose(local_anchor_, track_pose_);
+      pose = composePose(nodes_.back().pose, z);
+      edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
+    }
+    nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points});
+    if (!scans_.empty() && scans_.back().time_s == time_s) scans_.pop_back();  // the node is that scan
+    scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});
+    stats_.nodes = index + 1;
+    pending_.push_back(index);
+    rebuildLocalMapLocked();
+  }
+  if (params_.background) {
+    work_cv_.notify_one();
+  } else {
+    if (searchClosures(index)) optimize();
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.clear();
+  }
+  return true;
+}
+
+void GraphSlam::rebuildLocalMapLocked() {
+  std::vector<Eigen::Vector2d> reference;
+  const int n = static_cast<int>(nodes_.size());
+  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
+    const Eigen::Vector3d& p = nodes_[k].pose;
+    const double c = std::cos(p.z()), s = std::sin(p.z());
+    for (const auto& q : *nodes_[k].points) reference.emplace_back(p.x() + c * q.x() - s * q.y(), p.y() + s * q.x() + c * q.y());
+  }
+  // Under the lock with the node that it ends with, so that currentPose() never sees a new node
+  // with the old anchor.
+  local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, params_.match_sigma);
+  local_anchor_ = track_pose_ = nodes_.back().pose;
+  track_odom_ = nodes_.back().odom;
+}
+
+Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const std::vector<Eigen::Vector2d>& points) {
+  if (!local_map_ || points.empty()) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.local_match_failures;
+    return predicted;
+  }
+  const LikelihoodGrid& grid = *local_map_;
+  const MatchResult coarse = matchBranchAndBound(grid, points, predicted,
+                                                 {params_.local_search_window, params_.local_search_angle}, 0.0);
+  double score = 0.0;
+  Eigen::Vector3d refined = coarse.found ? refineMatch(grid, points, coarse.pose, 0.005, 4, &score) : predicted;
+  // Refinement only polishes the search's answer; a climb far beyond the window follows a slope
+  // of the score (a wall seen end on), not the scan.
+  if (coarse.found && ((refined.head<2>() - coarse.pose.head<2>()).norm() > 2.0 * params_.delta ||
+                       std::abs(normalizeAngle(refined.z() - coarse.pose.z())) > 0.02)) {
+    refined = coarse.pose;
+    score = coarse.score;
+  }
+  if (!coarse.found || score < params_.local_min_score) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.local_match_failures;
+    return predicted;
+  }
+  return refined;
+}
+
+void GraphSlam::backgroundLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    work_cv_.wait(lock, [this] { return stop_ || !pending_.empty(); });
+    if (stop_) return;
+    std::vector<int> batch(pending_.begin(), pending_.end());
+    pending_.clear();
+    busy_ = true;
+    lock.unlock();
+    bool added = false;
+    for (int n : batch) added = searchClosures(n) || added;
+    if (added) optimize();
+    lock.lock();
+    busy_ = false;
+    if (pending_.empty()) idle_cv_.notify_all();
+  }
+}
+
+void GraphSlam::flush() {
+  if (!params_.background) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_cv_.wait(lock, [this] { return pending_.empty() && !busy_; });
+}
+
+void GraphSlam::buildSubmap(int first, int last) {
+  std::vector<Eigen::Vector2d> points;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Eigen::Vector3d& anchor = nodes_[first].pose;
+    for (int k = first; k <= last; ++k) {
+      const Eigen::Vector3d p = relativePose(anchor, nodes_[k].pose);
+      const double c = std::cos(p.z()), s = std::sin(p.z());
+      for (const auto& q : *nodes_[k].points) points.emplace_back(p.x() + c * q.x() - s * q.y(), p.y() + s * q.x() + c * q.y());
+    }
+  }
+  auto grid = std::make_shared<const LikelihoodGrid>(points, params_.delta, params_.match_sigma);
+  std::lock_guard<std::mutex> lock(mutex_);
+  submaps_.push_back({first, last, grid});
+}
+
+bool GraphSlam::searchClosures(int n) {
+  if ((n + 1) % params_.submap_nodes == 0) buildSubmap(n + 1 - params_.submap_nodes, n);
+
+  struct Candidate {
+    double distance;
+    Eigen::Vector3d anchor;
+    int anchor_index;
+    std::shared_ptr<const LikelihoodGrid> grid;
+  };
+  std::vector<Candidate> candidates;
+  Eigen::Vector3d pose;
+  std::shared_ptr<const std::vector<Eigen::Vector2d>> points;
+  double travelled, radius;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pose = nodes_[n].pose;
+    points = nodes_[n].points;
+    travelled = nodes_[n].travelled_m;
+    radius = std::min(params_.loop_search_max_radius,
+                      params_.loop_search_radius + params_.loop_search_growth * (travelled - last_closure_travelled_));
+    stats_.search_radius_m = radius;
+    // Submaps the local map may still overlap are not loops.
+    const int recent = n - params_.local_map_nodes - params_.submap_nodes;
+    for (const Submap& s : submaps_) {
+      if (s.last >= recent) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int k = s.first; k <= s.last; ++k) nearest = std::min(nearest, (nodes_[k].pose.head<2>() - pose.head<2>()).norm());
+      if (nearest <= radius) candidates.push_back({nearest, nodes_[s.first].pose, s.first, s.grid});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+  if (static_cast<int>(candidates.size()) > params_.loop_candidates) candidates.resize(params_.loop_candidates);
+
+  bool added = false;
+  for (const Candidate& c : candidates) {
+    const Eigen::Vector3d init = relativePose(c.anchor, pose);
+    const MatchWindow window{radius, params_.loop_search_angle};
+    const MatchResult found = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_min_response);
+    int ambiguous = 0;
+    Eigen::Vector3d refined;
+    double score = 0.0;
+    if (found.found) {
+      refined = refineMatch(*c.grid, *points, found.pose, 0.005, 4, &score);
+      // The geometric check: a second pose elsewhere that explains the scan almost as well means
+      // the place is ambiguous (a corridor), so the match says nothing reliable.
+      const MatchResult other = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_ambiguity * found.score,
+                                                    &found.pose, 0.3, 0.1);
+      ambiguous = other.found ? 1 : 0;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.loop_attempts;
+    if (!found.found || score < params_.loop_min_response) continue;
+    if (ambiguous) {
+      ++stats_.loop_rejected_ambiguous;
+      continue;
+    }
+    edges_.push_back({c.anchor_index, n, refined, edgeInformation(1.0), true});
+    ++stats_.loop_closures;
+    last_closure_travelled_ = travelled;
+    added = true;
+  }
+  return added;
+}
+
+void GraphSlam::optimize() {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Eigen::Vector3d> poses;
+  std::vector<PoseGraphEdge> edges;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    poses.reserve(nodes_.size());
+    for (const Node& node : nodes_) poses.push_back(node.pose);
+    edges = edges_;
+  }
+  const std::vector<Eigen::Vector3d> before = poses;
+  PoseGraphOptions options;
+  // Wide first, so that consistent closures pull the drift out fully; then the nominal loss, under
+  // which a closure that disagrees with the rest weighs little.
+  options.cauchy_scale = 10.0 * params_.cauchy_scale;
+  optimizePoseGraph(poses, edges, options);
+  options.cauchy_scale = params_.cauchy_scale;
+  optimizePoseGraph(poses, edges, options);
+  std::vector<std::pair<int, int>> rejected;
+  std::vector<PoseGraphEdge> kept;
+  for (const auto& e : edges) {
+    const Eigen::Vector3d err = edgeError(poses[e.from], poses[e.to], e.measurement);
+    if (e.robust && err.dot(e.information * err) > params_.loop_reject_chi2) {
+      rejected.emplace_back(e.from, e.to);
+    } else {
+      kept.push_back(e);
+    }
+  }
+  if (!rejected.empty()) {
+    poses = before;
+    options.cauchy_scale = 10.0 * params_.cauchy_scale;
+    optimizePoseGraph(poses, kept, options);
+    options.cauchy_scale = params_.cauchy_scale;
+    optimizePoseGraph(poses, kept, options);
+  }
+  bool moved = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::size_t n0 = poses.size();
+    // Nodes added while optimizing move rigidly with the last optimized node.
+    const Eigen::Vector3d correction = composePose(poses[n0 - 1], inversePose(nodes_[n0 - 1].pose));
+    for (std::size_t k = 0; k < nodes_.size(); ++k) {
+      const Eigen::Vector3d updated = k < n0 ? poses[k] : composePose(correction, nodes_[k].pose);
+      moved = moved || (updated.head<2>() - nodes_[k].pose.head<2>()).norm() > 0.5 * params_.delta ||
+              std::abs(normalizeAngle(updated.z() - nodes_[k].pose.z())) > 0.5 * M_PI / 180.0;
+      nodes_[k].pose = updated;
+    }
+    for (const auto& r : rejected) {
+      edges_.erase(std::remove_if(edges_.begin(), edges_.end(),
+                                  [&](const PoseGraphEdge& e) { return e.robust && e.from == r.first && e.to == r.second; }),
+                   edges_.end());
+      --stats_.loop_closures;
+      ++stats_.loop_rejected_inconsistent;
+    }
+    ++stats_.optimizations;
+    stats_.last_optimization_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  if (moved) {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    map_dirty_ = true;
+  }
+}
+
+Eigen::Vector3d GraphSlam::currentPose() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (nodes_.empty()) return last_odom_;
+  // The last node as optimized, the tracked motion since it, then odometry since the last scan.
+  const Eigen::Vector3d tracked = composePose(nodes_.back().pose, relativePose(local_anchor_, track_pose_));
+  return composePose(tracked, relativePose(track_odom_, last_odom_));
+}
+
+std::vector<TrajectoryNode> GraphSlam::trajectory() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<TrajectoryNode> out;
+  out.reserve(nodes_.size());
+  for (const Node& n : nodes_) out.push_back({n.pose, n.odom, n.time_s, nullptr});
+  return out;
+}
+
+std::vector<std::pair<double, Eigen::Vector3d>> GraphSlam::scanPoses() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::pair<double, Eigen::Vector3d>> out;
+  out.reserve(scans_.size());
+  for (const TrackedScan& t : scans_) out.emplace_back(t.time_s, composePose(nodes_[t.node].pose, t.offset));
+  return out;
+}
+
+int GraphSlam::updates() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(nodes_.size());
+}
+
+GraphSlamStats GraphSlam::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+std::vector<PoseGraphEdge> GraphSlam::edges() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return edges_;
+}
+
+OccupancyImage GraphSlam::occupancy(double occ_thresh) const {
+  std::lock_guard<std::mutex> map_lock(map_mutex_);
+  std::vector<std::pair<Eigen::Vector3d, std::shared_ptr<const LaserScan>>> scans;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const Node& n : nodes_) scans.emplace_back(n.pose, n.scan);
+  }
+  if (map_dirty_) {
+    map_ = SlamGrid({params_.xmin, params_.ymin}, {params_.xmax, params_.ymax}, params_.delta);
+    map_nodes_ = 0;
+    map_dirty_ = false;
+  }
+  for (std::size_t k = map_nodes_; k < scans.size(); ++k) registrar_.registerScan(map_, scans[k].first, *scans[k].second);
+  map_nodes_ = static_cast<int>(scans.size());
+  return map_.toOccupancy(occ_thresh);
+}
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,165 @@
+"""Typed wrappers over the two C++ SLAM backends, configured with the slam_gmapping node's names.
+
+`make_slam('rbpf' | 'graph', {name: value}, laser_pose)` builds either; both offer process_scan,
+current_pose, trajectory, occupancy and updates (core/slam_backend.h). Poses are the base in the
+map frame (x [m], y [m], yaw [rad]).
+"""
+import difflib
+from typing import Dict, Tuple
+
+import numpy as np
+
+from mbot_slam_navigation import _core
+
+# The parameters both backends read (slam_gmapping's names and ROS defaults).
+COMMON_DEFAULTS = {
+    'maxUrange': 80.0, 'maxRange': 80.0, 'linearUpdate': 1.0, 'angularUpdate': 0.5, 'temporalUpdate': -1.0,
+    'xmin': -100.0, 'ymin': -100.0, 'xmax': 100.0, 'ymax': 100.0, 'delta': 0.05,
+}
+# The particle filter's own (gmapping's).
+GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
+    'sigma': 0.05, 'kernelSize': 1, 'lstep': 0.05, 'astep': 0.05, 'iterations': 5, 'lsigma': 0.075, 'ogain': 3.0,
+    'lskip': 0, 'minimumScore': 0.0, 'srr': 0.1, 'srt': 0.2, 'str': 0.1, 'stt': 0.2, 'resampleThreshold': 0.5,
+    'particles': 30, 'llsamplerange': 0.01, 'llsamplestep': 0.01, 'lasamplerange': 0.005, 'lasamplestep': 0.005,
+    'seed': 0,
+})
+# The pose graph's own (graph_slam.h; the node reads them under the same private names).
+GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
+    'match_max_range': 30.0, 'match_sigma': 0.05, 'local_map_nodes': 20, 'local_search_window': 0.15,
+    'local_search_angle': 0.15, 'local_min_score': 0.25, 'submap_nodes': 10, 'loop_search_radius': 2.0,
+    'loop_search_growth': 0.05, 'loop_search_max_radius': 6.0, 'loop_search_angle': 0.35,
+    'loop_min_response': 0.55, 'loop_ambiguity': 0.9, 'loop_candidates': 3,
+})
+BACKENDS = ('graph', 'rbpf')
+DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
+INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'local_map_nodes', 'submap_nodes',
+              'loop_candidates'}
+
+
+def defaults_of(backend: str) -> Dict[str, float]:
+    if backend not in BACKENDS:
+        raise ValueError('unknown SLAM backend "%s": use one of %s' % (backend, ', '.join(BACKENDS)))
+    return GRAPH_DEFAULTS if backend == 'graph' else GMAPPING_DEFAULTS
+
+
+def _merged(defaults, overrides, backend):
+    for key in overrides:
+        if key not in defaults:
+            near = difflib.get_close_matches(key, defaults, n=1)
+            raise KeyError('unknown %s SLAM parameter "%s"%s' % (backend, key, ' (did you mean "%s"?)' % near[0] if near else ''))
+    return dict(defaults, **overrides)
+
+
+def _matcher(v, laser_pose):
+    m = _core._ScanMatcherParams()
+    for name, key in (('sigma', 'sigma'), ('lstep', 'lstep'), ('astep', 'astep'), ('lsigma', 'lsigma')):
+        if key in v:
+            setattr(m, name, v[key])
+    for name, key in (('kernel_size', 'kernelSize'), ('iterations', 'iterations'), ('lskip', 'lskip')):
+        if key in v:
+            setattr(m, name, int(v[key]))
+    m.max_urange, m.max_range = v['maxUrange'], v['maxRange']
+    m.laser_pose = np.asarray(laser_pose, float)
+    return m
+
+
+def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
+    """_RbpfParams from gmapping-named values; an unknown name raises KeyError with the nearest one."""
+    v = _merged(GMAPPING_DEFAULTS, overrides, 'rbpf')
+    p = _core._RbpfParams()
+    p.particles, p.linear_update, p.angular_update = int(v['particles']), v['linearUpdate'], v['angularUpdate']
+    p.temporal_update, p.resample_threshold, p.ogain = v['temporalUpdate'], v['resampleThreshold'], v['ogain']
+    p.minimum_score, p.delta = v['minimumScore'], v['delta']
+    p.llsamplerange, p.llsamplestep = v['llsamplerange'], v['llsamplestep']
+    p.lasamplerange, p.lasamplestep = v['lasamplerange'], v['lasamplestep']
+    p.xmin, p.ymin, p.xmax, p.ymax = v['xmin'], v['ymin'], v['xmax'], v['ymax']
+    p.seed = int(v['seed'])
+    motion = _core._MotionModelParams()
+    motion.srr, motion.srt, motion.str, motion.stt = v['srr'], v['srt'], v['str'], v['stt']
+    p.motion = motion
+    p.matcher = _matcher(v, laser_pose)
+    p.validate()
+    return p
+
+
+def make_graph_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
+    """_GraphSlamParams from node-named values (offline runs are synchronous unless asked)."""
+    v = _merged(GRAPH_DEFAULTS, overrides, 'graph')
+    p = _core._GraphSlamParams()
+    p.linear_update, p.angular_update, p.temporal_update = v['linearUpdate'], v['angularUpdate'], v['temporalUpdate']
+    p.delta, p.xmin, p.ymin, p.xmax, p.ymax = v['delta'], v['xmin'], v['ymin'], v['xmax'], v['ymax']
+    p.matcher = _matcher(v, laser_pose)
+    for key in GRAPH_DEFAULTS:
+        if key not in COMMON_DEFAULTS:
+            setattr(p, key, int(v[key]) if key in INT_PARAMS else float(v[key]))
+    p.background = background
+    p.validate()
+    return p
+
+
+class _Backend:
+    _impl = None
+
+    def process_scan(self, odom, angle_min, angle_increment, range_min, range_max, ranges, time) -> bool:
+        return self._impl.process_scan(np.asarray(odom, float), angle_min, angle_increment, range_min, range_max,
+                                       np.asarray(ranges, np.float32), time)
+
+    def current_pose(self) -> Tuple[float, float, float]:
+        return tuple(float(v) for v in self._impl.current_pose())
+
+    def trajectory(self) -> np.ndarray:
+        """(N, 7): time, pose x y yaw (map), odometry x y yaw, one row per map update."""
+        return self._impl.trajectory()
+
+    def occupancy(self, occ_thresh: float = 0.25):
+        """(data (H, W) int8 with -1/0/100, origin (x, y) [m], resolution [m])."""
+        data, origin, res = self._impl.occupancy(occ_thresh)
+        return data, (float(origin[0]), float(origin[1])), res
+
+    def finish(self):
+        """Waits for background work (the graph's optimizer); nothing for the particle filter."""
+
+    @property
+    def updates(self) -> int:
+        return self._impl.updates
+
+
+class RbpfSlam(_Backend):
+    """GMapping-style particle filter."""
+
+    def __init__(self, params=None, laser_pose=(0.0, 0.0, 0.0), **gmapping_params):
+        self._impl = _core._RbpfSlam(params or make_params(gmapping_params, laser_pose))
+
+    @property
+    def resamples(self) -> int:
+        return self._impl.resamples
+
+    def map_memory(self) -> Tuple[int, int]:
+        """(bytes the particles' maps hold, bytes they would hold if no patch were shared)."""
+        return self._impl.map_memory()
+
+
+class GraphSlam(_Backend):
+    """Pose graph with loop closure."""
+
+    def __init__(self, params=None, laser_pose=(0.0, 0.0, 0.0), background=False, **graph_params):
+        self._impl = _core._GraphSlam(params or make_graph_params(graph_params, laser_pose, background))
+
+    def finish(self):
+        self._impl.flush()
+
+    def scan_poses(self) -> np.ndarray:
+        """(M, 4): time, pose x y yaw (map) of every tracked scan, as optimized."""
+        return self._impl.scan_poses()
+
+    def stats(self) -> dict:
+        return self._impl.stats()
+
+    def closures(self):
+        """(from, to) node indices of the accepted loop closures."""
+        return self._impl.closures()
+
+
+def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
+    defaults_of(backend)
+    return GraphSlam(laser_pose=laser_pose, **params) if backend == 'graph' else RbpfSlam(laser_pose=laser_pose, **params)

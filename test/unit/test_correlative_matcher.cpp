@@ -1,0 +1,128 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "mbot_slam_navigation/core/cell.h"
+#include "mbot_slam_navigation/core/correlative_matcher.h"
+#include "mbot_slam_navigation/core/pose2d.h"
+#include "mbot_slam_navigation/core/world2d.h"
+
+using namespace mbot::core;
+
+namespace {
+// An L-shaped room with a pillar: every pose dimension is observable.
+World2D room() {
+  World2D w;
+  w.addBox({0, 4.05}, 0, 10.2, 0.1);
+  w.addBox({0, -4.05}, 0, 10.2, 0.1);
+  w.addBox({5.05, 0}, 0, 0.1, 8.2);
+  w.addBox({-5.05, 0}, 0, 0.1, 8.2);
+  w.addBox({2.5, 2.0}, 0, 5.0, 4.0);
+  w.addCylinder({-2.0, -1.0}, 0.4);
+  w.addBox({-3.5, 2.5}, 0.3, 0.8, 0.5);
+  return w;
+}
+
+LaserScan scanAt(const World2D& w, const Eigen::Vector3d& pose, std::mt19937& rng, double noise) {
+  LaserScan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = M_PI / 180;
+  s.range_min_m = 0.1;
+  s.range_max_m = 12.0;
+  s.ranges_m.resize(360);
+  w.castScan(pose, s.angle_min_rad, s.angle_increment_rad, 360, 0.1, 12.0, noise, 0.0, rng, s.ranges_m.data());
+  return s;
+}
+
+std::vector<Eigen::Vector2d> inWorld(const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& pose) {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& p : pts) out.push_back(composePose(pose, {p.x(), p.y(), 0.0}).head<2>());
+  return out;
+}
+}  // namespace
+
+TEST(CorrelativeMatcher, BranchAndBoundFindsTheExhaustiveOptimum) {
+  const World2D w = room();
+  std::mt19937 rng(3);
+  const Eigen::Vector3d ref(-1.0, 0.5, 0.3), truth(-0.6, 0.2, 0.45);
+  const LikelihoodGrid grid(inWorld(matchPoints(scanAt(w, ref, rng, 0.01), Eigen::Vector3d::Zero(), 11.0, 0.05), ref),
+                            0.05, 0.05);
+  const auto points = matchPoints(scanAt(w, truth, rng, 0.01), Eigen::Vector3d::Zero(), 11.0, 0.05);
+  const Eigen::Vector3d init(truth.x() + 0.17, truth.y() - 0.12, truth.z() + 0.08);
+  const MatchWindow window{0.3, 0.12};
+  const MatchResult bb = matchBranchAndBound(grid, points, init, window, 0.0);
+  ASSERT_TRUE(bb.found);
+
+  // Exhaustive search over the same lattice: the same angles and whole-cell offsets.
+  double dmax = 0;
+  for (const auto& p : points) dmax = std::max(dmax, p.norm());
+  const double astep = std::acos(1.0 - 0.05 * 0.05 / (2 * dmax * dmax));
+  const int na = static_cast<int>(std::ceil(window.angular_rad / astep)), wl = 6;
+  int best = -1;
+  for (int a = -na; a <= na; ++a) {
+    const double yaw = init.z() + a * astep;
+    for (int ox = -wl; ox <= wl; ++ox) {
+      for (int oy = -wl; oy <= wl; ++oy) {
+        int sum = 0;
+        for (const auto& p : points) {
+          const Eigen::Vector2d q = composePose({init.x(), init.y(), yaw}, {p.x(), p.y(), 0}).head<2>();
+          const Cell c = worldToCell(grid.origin(), 0.05, q);
+          sum += grid.value(c.x + ox, c.y + oy);
+        }
+        best = std::max(best, sum);
+      }
+    }
+  }
+  EXPECT_NEAR(bb.score, best / (255.0 * points.size()), 1e-9);
+  EXPECT_LT((bb.pose.head<2>() - truth.head<2>()).norm(), 0.06);
+  EXPECT_LT(std::abs(normalizeAngle(bb.pose.z() - truth.z())), 0.02);
+
+  double score = 0;
+  const Eigen::Vector3d refined = refineMatch(grid, points, bb.pose, 0.005, 4, &score);
+  EXPECT_GE(score, grid.score(points, bb.pose));
+  EXPECT_LT((refined.head<2>() - truth.head<2>()).norm(), 0.03);
+  EXPECT_LT(std::abs(normalizeAngle(refined.z() - truth.z())), 0.01);
+}
+
+TEST(CorrelativeMatcher, FindsALargeOffsetAndRespectsTheMinimumAndExclusion) {
+  const World2D w = room();
+  std::mt19937 rng(5);
+  const Eigen::Vector3d truth(-2.5, 1.0, -0.4);
+  std::vector<Eigen::Vector2d> ref;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(-3, 1, 0), Eigen::Vector3d(0, -2, 1.5), Eigen::Vector3d(3, -2, 3)}) {
+    const auto pts = inWorld(matchPoints(scanAt(w, p, rng, 0.0), Eigen::Vector3d::Zero(), 11.0, 0.05), p);
+    ref.insert(ref.end(), pts.begin(), pts.end());
+  }
+  const LikelihoodGrid grid(ref, 0.05, 0.05);
+  const auto points = matchPoints(scanAt(w, truth, rng, 0.01), Eigen::Vector3d::Zero(), 11.0, 0.05);
+  // 2.1 m and 0.3 rad off: a loop closure's search, not a tracking one.
+  const Eigen::Vector3d init(truth.x() + 1.5, truth.y() - 1.5, truth.z() + 0.3);
+  const MatchResult r = matchBranchAndBound(grid, points, init, {2.5, 0.4}, 0.5);
+  ASSERT_TRUE(r.found);
+  EXPECT_GT(r.score, 0.6);
+  EXPECT_LT((r.pose.head<2>() - truth.head<2>()).norm(), 0.06);
+  EXPECT_LT(std::abs(normalizeAngle(r.pose.z() - truth.z())), 0.02);
+  // No pose in a window that excludes the truth reaches the minimum.
+  EXPECT_FALSE(matchBranchAndBound(grid, points, init, {0.5, 0.1}, 0.5).found);
+  // Nothing else in the room explains the scan nearly as well.
+  EXPECT_FALSE(matchBranchAndBound(grid, points, init, {2.5, 0.4}, 0.9 * r.score, &r.pose, 0.3, 0.1).found);
+}
+
+TEST(CorrelativeMatcher, PointsSkipInvalidAndFarReturnsAndThinOut) {
+  LaserScan s;
+  s.angle_min_rad = 0.0;
+  s.angle_increment_rad = 0.001;
+  s.range_min_m = 0.2;
+  s.range_max_m = 30.0;
+  s.ranges_m = {1.02f, 1.02f, NAN, INFINITY, -INFINITY, 0.1f, 25.0f, 3.0f};
+  const auto pts = matchPoints(s, Eigen::Vector3d(0.1, 0, 0), 20.0, 0.05);
+  ASSERT_EQ(pts.size(), 2u);  // the two 1 m beams fall in one cell; 25 m is beyond 20 m
+  EXPECT_NEAR(pts[0].x(), 1.12, 1e-6);
+  EXPECT_NEAR(pts[1].norm(), 3.1, 0.01);
+}
+
+TEST(CorrelativeMatcher, RejectsBadGridParameters) {
+  EXPECT_THROW(LikelihoodGrid({}, 0.0, 0.05), std::invalid_argument);
+  EXPECT_THROW(LikelihoodGrid({}, 0.05, -1.0), std::invalid_argument);
+}
