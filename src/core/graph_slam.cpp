@@ -285,10 +285,6 @@ void GraphSlam::optimize() {
   }
   const std::vector<Eigen::Vector3d> before = poses;
   PoseGraphOptions options;
-  // Wide first, so that consistent closures pull the drift out fully; then the nominal loss, under
-  // which a closure that disagrees with the rest weighs little.
-  options.cauchy_scale = 10.0 * params_.cauchy_scale;
-  optimizePoseGraph(poses, edges, options);
   options.cauchy_scale = params_.cauchy_scale;
   optimizePoseGraph(poses, edges, options);
   std::vector<std::pair<int, int>> rejected;
@@ -303,9 +299,6 @@ void GraphSlam::optimize() {
   }
   if (!rejected.empty()) {
     poses = before;
-    options.cauchy_scale = 10.0 * params_.cauchy_scale;
-    optimizePoseGraph(poses, kept, options);
-    options.cauchy_scale = params_.cauchy_scale;
     optimizePoseGraph(poses, kept, options);
   }
   bool moved = false;

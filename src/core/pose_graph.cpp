@@ -45,15 +45,10 @@ double robustWeight(const PoseGraphEdge& edge, double squared_error, double cauc
   return 1.0 / (1.0 + squared_error / (cauchy_scale * cauchy_scale));
 }
 
-PoseGraphSummary optimizePoseGraph(std::vector<Eigen::Vector3d>& poses, const std::vector<PoseGraphEdge>& edges,
-                                   const PoseGraphOptions& options) {
+namespace {
+PoseGraphSummary solve(std::vector<Eigen::Vector3d>& poses, const std::vector<PoseGraphEdge>& edges,
+                       const PoseGraphOptions& options) {
   const int n = static_cast<int>(poses.size());
-  for (const auto& e : edges) {
-    if (e.from < 0 || e.to < 0 || e.from >= n || e.to >= n || e.from == e.to) {
-      throw std::invalid_argument("pose graph: edge " + std::to_string(e.from) + " -> " + std::to_string(e.to) +
-                                  " does not join two of the " + std::to_string(n) + " nodes");
-    }
-  }
   PoseGraphSummary summary;
   summary.initial_cost = summary.final_cost = totalCost(poses, edges, options.cauchy_scale);
   if (n < 2 || edges.empty()) {
@@ -131,6 +126,28 @@ PoseGraphSummary optimizePoseGraph(std::vector<Eigen::Vector3d>& poses, const st
     }
   }
   return summary;
+}
+
+}  // namespace
+
+PoseGraphSummary optimizePoseGraph(std::vector<Eigen::Vector3d>& poses, const std::vector<PoseGraphEdge>& edges,
+                                   const PoseGraphOptions& options) {
+  const int n = static_cast<int>(poses.size());
+  for (const auto& e : edges) {
+    if (e.from < 0 || e.to < 0 || e.from >= n || e.to >= n || e.from == e.to) {
+      throw std::invalid_argument("pose graph: edge " + std::to_string(e.from) + " -> " + std::to_string(e.to) +
+                                  " does not join two of the " + std::to_string(n) + " nodes");
+    }
+  }
+  if (!options.graduated) return solve(poses, edges, options);
+  const double initial_cost = totalCost(poses, edges, options.cauchy_scale);
+  PoseGraphOptions wide = options;
+  wide.cauchy_scale *= 10.0;
+  const PoseGraphSummary first = solve(poses, edges, wide);
+  PoseGraphSummary second = solve(poses, edges, options);
+  second.iterations += first.iterations;
+  second.initial_cost = initial_cost;
+  return second;
 }
 
 }  // namespace core

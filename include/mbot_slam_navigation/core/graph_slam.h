@@ -58,7 +58,7 @@ struct GraphSlamParams {
   ScanMatcherParams matcher;
 
   double match_max_range = 30.0;    ///< [m] returns farther than this are not matched (`~match_max_range`)
-  double match_sigma = 0.05;        ///< [m] likelihood kernel (`~match_sigma`)
+  double match_sigma = 0.075;       ///< [m] likelihood kernel (`~match_sigma`)
   int local_map_nodes = 20;         ///< nodes in the local map (`~local_map_nodes`)
   double local_search_window = 0.15; ///< [m] +- x, y around the odometry prediction (`~local_search_window`)
   double local_search_angle = 0.15; ///< [rad] +- yaw (`~local_search_angle`)

@@ -28,8 +28,12 @@ struct PoseGraphEdge {
 };
 
 struct PoseGraphOptions {
-  int max_iterations = 20;
-  double cauchy_scale = 1.0;        ///< c of the Cauchy loss, in units of sqrt(e^T Omega e)
+  int max_iterations = 20;          ///< per stage
+  double cauchy_scale = 3.0;        ///< c of the Cauchy loss, in units of sqrt(e^T Omega e)
+  /// Solve first with 10 * cauchy_scale, then with cauchy_scale. The Cauchy loss is not convex:
+  /// started from drifted poses, where even good closures have large errors, it would weigh them
+  /// all down; the wide stage lets consistent closures pull the drift out first.
+  bool graduated = true;
   double tolerance = 1e-6;          ///< stop when no pose moves more than this [m or rad]
 };
 
@@ -46,8 +50,8 @@ Eigen::Vector3d edgeError(const Eigen::Vector3d& a, const Eigen::Vector3d& b, co
 /// robust ones (s = e^T Omega e).
 double robustWeight(const PoseGraphEdge& edge, double squared_error, double cauchy_scale);
 
-/// Optimizes `poses` in place; edges refer to indices of `poses`. Throws std::invalid_argument on
-/// an edge whose index is out of range.
+/// Optimizes `poses` in place (both stages when `graduated`); edges refer to indices of `poses`.
+/// Throws std::invalid_argument on an edge whose index is out of range.
 PoseGraphSummary optimizePoseGraph(std::vector<Eigen::Vector3d>& poses, const std::vector<PoseGraphEdge>& edges,
                                    const PoseGraphOptions& options);
 
