@@ -42,7 +42,13 @@ Eigen::Vector3d toPose(const geometry_msgs::TransformStamped& t) {
 class SlamGmappingNode {
  public:
   SlamGmappingNode() : pnh_("~"), tf_listener_(tf_buffer_) {
-    readParameters();
+    try {
+      readParameters();
+    } catch (const std::invalid_argument& e) {
+      // Logged here: once this node's handles are gone, roscpp has shut rosconsole down.
+      ROS_FATAL("slam_gmapping: %s", e.what());
+      throw;
+    }
     map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
     meta_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
     entropy_pub_ = pnh_.advertise<std_msgs::Float64>("entropy", 1, true);
@@ -111,6 +117,9 @@ class SlamGmappingNode {
     param("seed", seed);
     p.seed = static_cast<unsigned>(seed);
     param("backend", backend_);
+    if (backend_ != "graph" && backend_ != "rbpf") {
+      throw std::invalid_argument("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got '" + backend_ + "'");
+    }
     auto& g = graph_params_;
     param("match_max_range", g.match_max_range);
     param("match_sigma", g.match_sigma);
@@ -192,12 +201,10 @@ class SlamGmappingNode {
         std::lock_guard<std::mutex> lock(mutex_);
         if (backend_ == "rbpf") {
           slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
-        } else if (backend_ == "graph") {
+        } else {
           auto graph = graph_params_;
           graph.matcher = params.matcher;
           slam_ = std::make_unique<mbot::core::GraphSlam>(graph);
-        } else {
-          throw std::invalid_argument("backend must be 'graph' or 'rbpf', got '" + backend_ + "'");
         }
       } catch (const std::invalid_argument& e) {
         ROS_FATAL("slam_gmapping: bad parameter ~%s", e.what());
@@ -309,7 +316,11 @@ class SlamGmappingNode {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "slam_gmapping");
-  SlamGmappingNode node;
-  ros::spin();
+  try {
+    SlamGmappingNode node;
+    ros::spin();
+  } catch (const std::invalid_argument&) {
+    return 1;  // already logged
+  }
   return 0;
 }

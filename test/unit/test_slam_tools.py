@@ -54,8 +54,10 @@ def test_relations_metric():
     assert pose_at(times, poses, 100.0) is None  # no estimate near that time
 
 
-def test_slam_offline_on_a_rosbag(tmp_path):
-    """A bag recorded from the simulator's topics (/scan, /odom) goes through slam_offline."""
+@pytest.mark.parametrize('backend, params', [('rbpf', ['particles=5']), ('graph', ['loop_candidates=2'])])
+def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
+    """A bag recorded from the simulator's topics (/scan, /odom) goes through slam_offline, with
+    either backend and its own parameters."""
     import rosbag
     import rospy
     from nav_msgs.msg import Odometry
@@ -95,11 +97,34 @@ def test_slam_offline_on_a_rosbag(tmp_path):
                 scan.ranges = sim.scan(robot, robot.lasers[0]).tolist()
                 bag.write('/scan', scan, stamp)
     out = str(tmp_path / 'drive')
-    assert main([bag_path, '-o', out, '--quiet', '--param', 'particles=5', '--param', 'maxUrange=9.5',
-                 '--param', 'maxRange=10', '--param', 'linearUpdate=0.2', '--param', 'angularUpdate=0.2']) == 0
+    extra = [a for p in params for a in ('--param', p)]
+    assert main([bag_path, '-o', out, '--quiet', '--backend', backend, '--param', 'maxUrange=9.5',
+                 '--param', 'maxRange=10', '--param', 'linearUpdate=0.2', '--param', 'angularUpdate=0.2'] + extra) == 0
     traj = np.loadtxt(out + '.traj')
     assert traj.shape[1] == 4 and len(traj) == 150
     # The map frame starts at the first odometry pose (the spawn pose's odom is 0): compare motion.
     true_motion = relative2d((-2.5, -1.0, 0.0), robot.pose)
     assert np.hypot(traj[-1, 1] - true_motion[0], traj[-1, 2] - true_motion[1]) < 0.1
     assert os.path.exists(out + '.pgm') and os.path.exists(out + '.yaml')
+
+
+def test_slam_offline_names_an_unknown_parameter_of_the_backend(tmp_path, capsys):
+    """`particles` belongs to the particle filter: the graph backend refuses it by name."""
+    from mbot_slam_navigation.slam.offline import main
+    with pytest.raises(SystemExit) as e:
+        main([os.path.join(DATA, 'tiny.clf'), '-o', str(tmp_path / 'x'), '--quiet', '--param', 'particles=5'])
+    assert e.value.code == 2
+    assert 'unknown graph SLAM parameter "particles"' in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main([os.path.join(DATA, 'tiny.clf'), '-o', str(tmp_path / 'x'), '--quiet', '--backend', 'graph',
+              '--param', 'loop_min_respons=0.5'])
+    assert 'did you mean "loop_min_response"' in capsys.readouterr().err
+
+
+def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
+    from mbot_slam_navigation.slam.backends import GRAPH_DEFAULTS, make_graph_params
+    p = make_graph_params({'submap_nodes': 7, 'loop_min_response': 0.6, 'linearUpdate': 0.3})
+    assert (p.submap_nodes, p.loop_min_response, p.linear_update) == (7, 0.6, 0.3)
+    assert p.match_sigma == GRAPH_DEFAULTS['match_sigma'] and not p.background
+    with pytest.raises(ValueError, match='loop_min_response'):
+        make_graph_params({'loop_min_response': 2.0})
