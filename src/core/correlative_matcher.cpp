@@ -101,6 +101,8 @@ void LikelihoodGrid::buildLevels(int levels) const {
   }
 }
 
+void LikelihoodGrid::dropLevels() const { std::vector<std::vector<uint8_t>>().swap(levels_); }
+
 std::size_t LikelihoodGrid::bytes() const {
   std::size_t n = cells_.size();
   for (const auto& l : levels_) n += l.size();
@@ -111,7 +113,7 @@ std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vec
                                          double voxel_m) {
   std::vector<Eigen::Vector2d> out;
   out.reserve(scan.ranges_m.size());
-  std::unordered_set<int64_t> seen;
+  std::unordered_set<uint64_t> seen;
   const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     const double r = scan.ranges_m[i];
@@ -120,7 +122,8 @@ std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vec
     const Eigen::Vector2d p = laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a));
     if (voxel_m > 0.0) {
       const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
-      if (!seen.insert((kx << 32) ^ (ky & 0xffffffff)).second) continue;
+      const uint64_t key = (static_cast<uint64_t>(kx) << 32) ^ (static_cast<uint64_t>(ky) & 0xffffffffu);
+      if (!seen.insert(key).second) continue;
     }
     out.push_back(p);
   }

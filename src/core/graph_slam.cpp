@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -244,6 +245,14 @@ bool GraphSlam::searchClosures(int n) {
 
   bool added = false;
   for (const Candidate& c : candidates) {
+    // The pooled levels of a submap are 7 times its grid: keep them for the submaps matched
+    // lately (the robot is likely to be there again next node), free the others.
+    pyramids_.remove(c.grid);
+    pyramids_.push_front(c.grid);
+    if (static_cast<int>(pyramids_.size()) > kPyramidCache) {
+      pyramids_.back()->dropLevels();
+      pyramids_.pop_back();
+    }
     const Eigen::Vector3d init = relativePose(c.anchor, pose);
     const MatchWindow window{radius, params_.loop_search_angle};
     const MatchResult found = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_min_response);

@@ -220,10 +220,9 @@ class SlamGmappingNode {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
-      if (updated) {
-        // The graph's optimizer moves the current pose by its correction, and map -> odom with it.
-        map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
-      }
+      // gmapping moves map -> odom at its updates only; the graph tracks every scan, and its
+      // optimizer moves the current pose by exactly its correction, so map -> odom follows both.
+      if (updated || backend_ == "graph") map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
     }
     if (!updated) return;
     if (const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get())) {

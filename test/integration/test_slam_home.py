@@ -12,6 +12,7 @@ import numpy as np
 import rospkg
 import rospy
 import rostest
+from std_msgs.msg import Float64
 import tf2_ros
 from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import OccupancyGrid, Odometry
@@ -90,10 +91,13 @@ class SlamHomeTest(unittest.TestCase):
 
     def test_tutorial_typo_and_bad_scans_get_warnings(self):
         # A second instance, started as the tutorial does (~base_link, a typo for ~base_frame), in
-        # frames of its own, fed by this test: the warnings a user reads in the terminal.
+        # frames of its own, fed by this test: the warnings a user reads in the terminal. It runs the
+        # particle filter (the launch's instance runs the default pose graph), so both backends
+        # serve the node's topics here.
         ns = '/tc'
         proc = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=typo_check',
                                  '_base_link:=base_footprint', '_base_frame:=tc_base', '_odom_frame:=tc_odom',
+                                 '_backend:=rbpf', '_particles:=5',
                                  '_map_frame:=tc_map', '_map_update_interval:=0.1', '_temporalUpdate:=0.05',
                                  'scan:=%s/scan' % ns, 'map:=%s/map' % ns, 'map_metadata:=%s/map_metadata' % ns,
                                  'dynamic_map:=%s/dynamic_map' % ns],
@@ -147,6 +151,9 @@ class SlamHomeTest(unittest.TestCase):
                 pub.publish(scan(now + rospy.Duration(0.1 * (k + 1))))
                 rospy.sleep(0.3)
             rospy.wait_for_message(ns + '/map', OccupancyGrid, timeout=20.0)
+            # ~entropy is the particle filter's alone: the instance runs the backend it was asked for.
+            entropy = rospy.wait_for_message('/typo_check/entropy', Float64, timeout=10.0)
+            self.assertTrue(math.isfinite(entropy.data))
             pub.publish(scan(now - rospy.Duration(30.0)))  # a bag restarted
             self.assertTrue(printed('time went backwards'), ''.join(lines))
             self.assertIsNone(proc.poll(), 'slam_gmapping died on bad input')

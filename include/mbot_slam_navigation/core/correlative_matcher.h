@@ -52,6 +52,9 @@ class LikelihoodGrid {
   int pooled(int level, int x, int y) const;
   /// Builds levels 1..levels-1 now (they are otherwise built lazily by the matcher).
   void buildLevels(int levels) const;
+  /// Frees the pooled levels (they are rebuilt on the next match). Not thread-safe: a grid is
+  /// matched and trimmed by one thread.
+  void dropLevels() const;
   /// Bytes held (base grid and pooled levels), for cache accounting.
   std::size_t bytes() const;
 

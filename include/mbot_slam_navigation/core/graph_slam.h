@@ -32,6 +32,7 @@
 
 #include <condition_variable>
 #include <deque>
+#include <list>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -154,6 +155,9 @@ class GraphSlam : public SlamBackend {
   std::vector<Submap> submaps_;
   std::vector<TrackedScan> scans_;
   std::deque<int> pending_;  // nodes not yet searched for closures
+  // Submap grids whose pooled levels are kept, most recently matched first (closure thread only).
+  static constexpr int kPyramidCache = 16;
+  std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
   GraphSlamStats stats_;
   double last_closure_travelled_ = 0.0;
