@@ -12,6 +12,14 @@
 namespace mbot {
 namespace core {
 
+namespace {
+/// Appends `points` (a node's frame) moved by `pose` (that node in the target frame) to `out`.
+void appendMoved(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose, std::vector<Eigen::Vector2d>& out) {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  for (const auto& q : points) out.emplace_back(pose.x() + c * q.x() - s * q.y(), pose.y() + s * q.x() + c * q.y());
+}
+}  // namespace
+
 void GraphSlamParams::validate() const {
   auto positive = [](double v, const char* name) {
     if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument(std::string(name) + " must be positive, got " + std::to_string(v));
@@ -77,25 +85,26 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       travelled_ += step.head<2>().norm();
     }
   }
+  const bool due = first || linear_distance_ > params_.linear_update || angular_distance_ > params_.angular_update ||
+                   (params_.temporal_update >= 0.0 && time_s - last_update_time_ > params_.temporal_update);
   const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
   auto points = std::make_shared<const std::vector<Eigen::Vector2d>>(
       matchPoints(scan, params_.matcher.laser_pose, reach, params_.delta));
+  Eigen::Vector3d tracked = odom;
   if (!first) {
     // Every scan is tracked against the local map, so that the next node's prediction is a few
     // tenths of a second of odometry old, not a whole update's worth.
-    const Eigen::Vector3d predicted = composePose(track_pose_, relativePose(track_odom_, odom));
-    const Eigen::Vector3d tracked = matchLocally(predicted, *points);
-    std::lock_guard<std::mutex> lock(mutex_);
-    track_pose_ = tracked;
-    track_odom_ = odom;
-    scans_.push_back({time_s, static_cast<int>(nodes_.size()) - 1, relativePose(local_anchor_, tracked)});
+    tracked = matchLocally(composePose(track_pose_, relativePose(track_odom_, odom)), *points);
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     last_odom_ = odom;
+    if (!first) {
+      track_pose_ = tracked;
+      track_odom_ = odom;
+    }
+    if (!due) scans_.push_back({time_s, static_cast<int>(nodes_.size()) - 1, relativePose(local_anchor_, tracked)});
   }
-  const bool due = first || linear_distance_ > params_.linear_update || angular_distance_ > params_.angular_update ||
-                   (params_.temporal_update >= 0.0 && time_s - last_update_time_ > params_.temporal_update);
   if (!due) return false;
   linear_distance_ = angular_distance_ = 0.0;
   last_update_time_ = time_s;
@@ -113,8 +122,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
     }
     nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points});
-    if (!scans_.empty() && scans_.back().time_s == time_s) scans_.pop_back();  // the node is that scan
-    scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});
+    scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});  // the node is this scan
     stats_.nodes = index + 1;
     pending_.push_back(index);
     rebuildLocalMapLocked();
@@ -132,11 +140,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
 void GraphSlam::rebuildLocalMapLocked() {
   std::vector<Eigen::Vector2d> reference;
   const int n = static_cast<int>(nodes_.size());
-  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
-    const Eigen::Vector3d& p = nodes_[k].pose;
-    const double c = std::cos(p.z()), s = std::sin(p.z());
-    for (const auto& q : *nodes_[k].points) reference.emplace_back(p.x() + c * q.x() - s * q.y(), p.y() + s * q.x() + c * q.y());
-  }
+  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) appendMoved(*nodes_[k].points, nodes_[k].pose, reference);
   // Under the lock with the node that it ends with, so that currentPose() never sees a new node
   // with the old anchor.
   local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, params_.match_sigma);
@@ -199,11 +203,7 @@ void GraphSlam::buildSubmap(int first, int last) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const Eigen::Vector3d& anchor = nodes_[first].pose;
-    for (int k = first; k <= last; ++k) {
-      const Eigen::Vector3d p = relativePose(anchor, nodes_[k].pose);
-      const double c = std::cos(p.z()), s = std::sin(p.z());
-      for (const auto& q : *nodes_[k].points) points.emplace_back(p.x() + c * q.x() - s * q.y(), p.y() + s * q.x() + c * q.y());
-    }
+    for (int k = first; k <= last; ++k) appendMoved(*nodes_[k].points, relativePose(anchor, nodes_[k].pose), points);
   }
   auto grid = std::make_shared<const LikelihoodGrid>(points, params_.delta, params_.match_sigma);
   std::lock_guard<std::mutex> lock(mutex_);
