@@ -123,7 +123,6 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
     }
     nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points});
     scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});  // the node is this scan
-    stats_.nodes = index + 1;
     pending_.push_back(index);
     rebuildLocalMapLocked();
   }
@@ -275,7 +274,6 @@ bool GraphSlam::searchClosures(int n) {
       continue;
     }
     edges_.push_back({c.anchor_index, n, refined, edgeInformation(1.0), true});
-    ++stats_.loop_closures;
     last_closure_travelled_ = travelled;
     added = true;
   }
@@ -326,7 +324,6 @@ void GraphSlam::optimize() {
       edges_.erase(std::remove_if(edges_.begin(), edges_.end(),
                                   [&](const PoseGraphEdge& e) { return e.robust && e.from == r.first && e.to == r.second; }),
                    edges_.end());
-      --stats_.loop_closures;
       ++stats_.loop_rejected_inconsistent;
     }
     ++stats_.optimizations;
@@ -370,7 +367,10 @@ int GraphSlam::updates() const {
 
 GraphSlamStats GraphSlam::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return stats_;
+  GraphSlamStats out = stats_;
+  out.nodes = static_cast<int>(nodes_.size());
+  out.loop_closures = static_cast<int>(std::count_if(edges_.begin(), edges_.end(), [](const PoseGraphEdge& e) { return e.robust; }));
+  return out;
 }
 
 std::vector<PoseGraphEdge> GraphSlam::edges() const {

@@ -159,7 +159,7 @@ class GraphSlam : public SlamBackend {
   static constexpr int kPyramidCache = 16;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
-  GraphSlamStats stats_;
+  GraphSlamStats stats_;  // counters; nodes and loop_closures are derived in stats()
   double last_closure_travelled_ = 0.0;
 
   Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero();
