@@ -21,6 +21,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Header.h>
 #include <tf2/utils.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
@@ -52,6 +53,7 @@ class SlamGmappingNode {
     map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
     meta_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
     entropy_pub_ = pnh_.advertise<std_msgs::Float64>("entropy", 1, true);
+    if (ros::Time::isSimTime()) heartbeat_pub_ = nh_.advertise<std_msgs::Header>("/sim_heartbeat", 10);
     map_srv_ = nh_.advertiseService("dynamic_map", &SlamGmappingNode::onDynamicMap, this);
     scan_sub_ = nh_.subscribe("scan", 5, &SlamGmappingNode::onScan, this);
     if (transform_publish_period_ > 0.0) {
@@ -224,6 +226,7 @@ class SlamGmappingNode {
       // optimizer moves the current pose by exactly its correction, so map -> odom follows both.
       if (updated || backend_ == "graph") map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
     }
+    beatHeartbeat(msg->header.stamp);
     if (!updated) return;
     if (const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get())) {
       std_msgs::Float64 entropy;
@@ -234,6 +237,16 @@ class SlamGmappingNode {
       publishMap(msg->header.stamp);
       last_map_update_ = msg->header.stamp;
     }
+  }
+
+  // Tells a simulator running real_time_factor:=auto how far SLAM has got: the stamp of the scan
+  // just processed (std_msgs/Header on /sim_heartbeat; see sim/pacing.py). Only on simulated time.
+  void beatHeartbeat(const ros::Time& stamp) {
+    if (!heartbeat_pub_) return;
+    std_msgs::Header beat;
+    beat.stamp = stamp;
+    beat.frame_id = ros::this_node::getName();
+    heartbeat_pub_.publish(beat);
   }
 
   void publishMap(const ros::Time& stamp) {
@@ -299,7 +312,7 @@ class SlamGmappingNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Publisher map_pub_, meta_pub_, entropy_pub_;
+  ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_;
   ros::Subscriber scan_sub_;
   ros::ServiceServer map_srv_;
   std::mutex mutex_, map_mutex_;

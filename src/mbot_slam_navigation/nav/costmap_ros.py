@@ -19,6 +19,7 @@ from sensor_msgs.msg import LaserScan
 
 from mbot_slam_navigation.nav.costmap import CostmapConfig, LayeredCostmap
 from mbot_slam_navigation.ros_msgs import occupancy_grid_msg
+from mbot_slam_navigation.sim_heartbeat import Heartbeat
 from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
@@ -37,6 +38,7 @@ class CostmapROS:
         self.robot_pose = None
         self.last_update = None
         self.tf_problem = ''
+        self.heartbeat = Heartbeat()  # how current the robot pose is, for the simulator's auto pacing
         self.ever_updated = False
         self.update_seq = 0
         self.costmap_pub = rospy.Publisher('~%s/costmap' % name, OccupancyGrid, queue_size=1, latch=True)
@@ -101,6 +103,7 @@ class CostmapROS:
         except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as e:
             self.tf_problem = 'no transform from %s to %s: %s' % (c.robot_base_frame, c.global_frame, e)
             return None
+        self.heartbeat.beat(t.header.stamp)
         age = (rospy.Time.now() - t.header.stamp).to_sec()
         if t.header.stamp != rospy.Time(0) and age > c.transform_tolerance:
             self.tf_problem = ('the transform from %s to %s is %.2f s old, more than transform_tolerance %.2f s'

@@ -1,32 +1,40 @@
 """gazebo_sim: the ROS face of the 2D simulator (stands in for gzserver + gazebo_ros plugins).
 
-Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible),
-step_size (0.01 s), pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false),
-odometry_slip_stddev (0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0),
-gazebo_namespace ("gazebo": where services and the contacts topic live).
+Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
+'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
+min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.15 simulated s: the
+lag of the slowest node that auto aims below), step_size (0.01 s), pub_clock_frequency (100 Hz of
+simulated time), paused (false), gui (false), odometry_slip_stddev (0.02, relative, for encoder
+odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace ("gazebo": where services and the contacts topic live).
 
 Publishes /clock; per robot (in its namespace): the drive's odometry topic and odom -> base tf,
 each laser's LaserScan, base_pose_ground_truth (nav_msgs/Odometry in the world frame). Services
 <ns>/spawn_urdf_model, delete_model, get_model_state, set_model_state, pause_physics,
 unpause_physics, reset_simulation, reset_world; topic <ns>/contacts (mbot_slam_navigation/Contact).
-Message stamps are simulated time; the node itself paces on the wall clock.
+~real_time_factor (std_msgs/Float64, every 0.25 s wall: the factor reached) with a line every 10 s
+wall when auto. Message stamps are simulated time; the node itself paces on the wall clock.
+
+No publish waits for a subscriber (sim/nonblocking_publisher.py): a stopped or slow subscriber loses
+messages, and the simulation keeps its rate.
 """
 import math
 import os
 import threading
 import time
-import warnings
 
 import rospy
 from geometry_msgs.msg import Pose2D, TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Float64, Header
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.ros_msgs import pose_msg
+from mbot_slam_navigation.sim.nonblocking_publisher import nonblocking_publisher
+from mbot_slam_navigation.sim.pacing import PacingError, make_pacer
 from mbot_slam_navigation.sim.sdf_world import World, load_world
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
 from mbot_slam_navigation.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
@@ -35,19 +43,6 @@ from mbot_slam_navigation.sim.urdf_robot import parse_urdf
 from mbot_slam_navigation.sim.xmlutil import XmlError
 from mbot_slam_navigation.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
                                       SetModelState, SetModelStateResponse, SpawnModel, SpawnModelResponse)
-
-
-def sync_publisher(topic, msg_type, latch=False):
-    """A publisher that writes to its subscribers' sockets in the calling thread.
-
-    rospy's queued publishers yield the thread after every message (time.sleep(0) in
-    QueuedConnection.write_data) so that their writer thread can run: about 80 us per message here,
-    which at /clock + odometry + tf + scans is most of the simulator's time. The simulator is the
-    one node that publishes at that rate, and TCP buffers the data anyway, so it writes directly.
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore')  # rospy warns when queue_size is None; that is the point here
-        return rospy.Publisher(topic, msg_type, queue_size=None, latch=latch)
 
 
 def _prefixed(namespace: str, frame: str) -> str:
@@ -70,9 +65,9 @@ class RobotIO:
 
         self.odom_frame = _prefixed(ns, drive.odometry_frame)
         self.base_frame = _prefixed(ns, drive.robot_base_frame)
-        self.odom_pub = sync_publisher(topic(drive.odometry_topic), Odometry)
-        self.truth_pub = sync_publisher(topic('base_pose_ground_truth'), Odometry)
-        self.scan_pubs = [sync_publisher(topic(l.spec.topic), LaserScan) for l in robot.lasers]
+        self.odom_pub = nonblocking_publisher(topic(drive.odometry_topic), Odometry)
+        self.truth_pub = nonblocking_publisher(topic('base_pose_ground_truth'), Odometry)
+        self.scan_pubs = [nonblocking_publisher(topic(l.spec.topic), LaserScan) for l in robot.lasers]
         self.cmd_topic = topic(drive.command_topic)
         self.cmd_sub = rospy.Subscriber(self.cmd_topic, Twist, node.on_cmd_vel, callback_args=robot.name, queue_size=5)
 
@@ -84,16 +79,18 @@ class RobotIO:
 
 class SimNode:
     def __init__(self):
-        self.rtf = float(rospy.get_param('~real_time_factor', 1.0))
+        self.pacer = make_pacer(rospy.get_param('~real_time_factor', 1.0),
+                                min_rtf=float(rospy.get_param('~min_real_time_factor', 0.25)),
+                                max_rtf=float(rospy.get_param('~max_real_time_factor', 100.0)),
+                                max_lag=float(rospy.get_param('~max_lag', 0.15)))
         step = float(rospy.get_param('~step_size', 0.01))
         clock_hz = float(rospy.get_param('~pub_clock_frequency', 100.0))
         self.paused = bool(rospy.get_param('~paused', False))
         self.gui = bool(rospy.get_param('~gui', False))
         self.gz_ns = '/' + rospy.get_param('~gazebo_namespace', 'gazebo').strip('/')
         world_path = rospy.get_param('~world_name', '')
-        if self.rtf < 0 or not clock_hz > 0:
-            raise ValueError('~real_time_factor must be >= 0 and ~pub_clock_frequency > 0 (got %r, %r)'
-                             % (self.rtf, clock_hz))
+        if not clock_hz > 0:
+            raise ValueError('~pub_clock_frequency must be > 0 (got %r)' % clock_hz)
         if world_path:
             world = load_world(world_path)  # raises XmlError naming file and line
         else:
@@ -110,9 +107,13 @@ class SimNode:
         self.next_clock = 0.0
         self.lock = threading.RLock()
         self.io = {}
-        self.clock_pub = sync_publisher('/clock', Clock)
+        self.clock_pub = nonblocking_publisher('/clock', Clock)
         self.contact_pub = rospy.Publisher(self.gz_ns + '/contacts', Contact, queue_size=20)
-        self.tf_pub = sync_publisher('/tf', TFMessage)
+        self.tf_pub = nonblocking_publisher('/tf', TFMessage)
+        self.rtf_pub = rospy.Publisher('~real_time_factor', Float64, queue_size=1)
+        self.pacer_lock = threading.Lock()
+        self.free_running_warned = False
+        rospy.Subscriber('/sim_heartbeat', Header, self.on_heartbeat, queue_size=50)
         s = self.gz_ns + '/'
         rospy.Service(s + 'spawn_urdf_model', SpawnModel, self.on_spawn)
         rospy.Service(s + 'delete_model', DeleteModel, self.on_delete)
@@ -210,6 +211,44 @@ class SimNode:
         rospy.loginfo('gazebo_sim: simulation reset')
         return EmptyResponse()
 
+    def on_heartbeat(self, msg):
+        """A consumer of simulated time says how far it has got (sim/pacing.py)."""
+        lag = self.sim.time - msg.stamp.to_sec()
+        with self.pacer_lock:
+            self.pacer.heartbeat(msg.frame_id or '(unnamed)', lag, time.monotonic())
+
+    def pace(self, now: float, wall0: float, sim0: float):
+        """Sleeps as the real-time factor requires; returns the (wall, sim) pair to pace from."""
+        wall = time.monotonic()
+        with self.pacer_lock:
+            decided = self.pacer.update(wall, now)
+            p = self.pacer
+            if decided:
+                self.rtf_pub.publish(Float64(p.achieved))
+                if not p.auto and math.isinf(p.rtf) and p.worst[1] > 1.0 and not self.free_running_warned:
+                    # real_time_factor 0 runs the clock away from the stack: keep it as fast as the
+                    # stack goes instead, and say so.
+                    self.free_running_warned = True
+                    rospy.logwarn('gazebo_sim: real_time_factor 0 runs /clock %.1f s ahead of %s; running as fast as '
+                                  'the nodes keep up instead, as real_time_factor:=auto does (auto also bounds it with '
+                                  '~min_real_time_factor/~max_real_time_factor)' % (p.worst[1], p.worst[0]))
+                    p.auto, p.max_rtf = True, math.inf
+                if p.auto and wall - self.last_report >= 10.0:
+                    self.last_report = wall
+                    rospy.loginfo('gazebo_sim: running at %.1fx real time (auto%s)' % (
+                        p.achieved, '; slowest: %s %.2f s behind' % p.worst if p.worst[0] else '; no node reports lag'))
+            rtf = p.rtf
+        if decided:
+            return wall, now  # pace the new factor from here
+        if math.isinf(rtf):
+            return wall0, sim0
+        ahead = (now - sim0) / rtf - (wall - wall0)
+        if ahead > 0:
+            time.sleep(ahead)
+        elif ahead < -0.1:
+            return wall, now  # starved of CPU: go on at the factor, do not race to catch up
+        return wall0, sim0
+
     def on_cmd_vel(self, msg, name):
         with self.lock:
             if name not in self.sim.robots:
@@ -283,10 +322,13 @@ class SimNode:
     def run(self):
         wall0, sim0 = time.monotonic(), self.sim.time
         last_viewer = 0.0
+        self.last_report = wall0
         while not rospy.is_shutdown():
             if self.paused:
                 time.sleep(0.01)
                 wall0, sim0 = time.monotonic(), self.sim.time
+                with self.pacer_lock:
+                    self.pacer.restart(wall0, sim0)
                 continue
             with self.lock:
                 contacts = self.sim.step()
@@ -324,17 +366,16 @@ class SimNode:
                     self.viewer.draw(self.sim)
             if now < sim0:  # reset_simulation took time back: pace from here
                 wall0, sim0 = time.monotonic(), now
-            if self.rtf > 0:
-                ahead = (now - sim0) / self.rtf - (time.monotonic() - wall0)
-                if ahead > 0:
-                    time.sleep(ahead)
+                with self.pacer_lock:
+                    self.pacer.restart(wall0, now)
+            wall0, sim0 = self.pace(now, wall0, sim0)
 
 
 def main():
     rospy.init_node('gazebo_sim')
     try:
         node = SimNode()
-    except (XmlError, ValueError) as e:
+    except (XmlError, ValueError, PacingError) as e:
         rospy.logfatal('gazebo_sim: %s', e)
         raise SystemExit(1)
     node.run()

@@ -1,0 +1,106 @@
+"""How fast simulated time runs against the wall clock: a fixed real-time factor, or `auto`, which
+runs as fast as the nodes that consume simulated time keep up, and no faster. ROS-free.
+
+The nodes that matter (slam_gmapping, move_base, amcl) publish a heartbeat (std_msgs/Header on
+/sim_heartbeat): `stamp` is the simulated time of the newest input they have fully processed,
+`frame_id` the node's name. On arrival the simulator's clock is ahead of that stamp by the node's
+lag [simulated s]: its queue, its processing time and the transport, all in simulated seconds,
+which is what a node's transform_tolerance and expected_update_rate are checked against.
+
+Every `adjust_period` wall seconds the worst lag over the period (among nodes heard from within
+`forget_after` wall seconds, so that a stopped or dead node does not hold the simulation still)
+sets the factor: above `max_lag` it falls in proportion (at most halved), below half of it the
+factor rises by `increase` per period, up to `max_rtf`; with no heartbeat at all it rises to the
+maximum. A factor of inf means "as fast as the simulator goes" (no sleeping).
+"""
+import math
+from dataclasses import dataclass, field
+from typing import Dict, Optional, Tuple
+
+AUTO = 'auto'
+
+
+class PacingError(ValueError):
+    """A real_time_factor parameter that cannot be used (names the parameter)."""
+
+
+@dataclass
+class _Heard:
+    lag: float = 0.0       # [simulated s] worst lag since the last adjustment
+    last_wall: float = 0.0  # [wall s] when the last heartbeat arrived
+
+
+@dataclass
+class Pacer:
+    """The real-time factor. `auto` False: `rtf` stays as given (inf = free-running)."""
+    rtf: float = 1.0                 # [sim s / wall s] current target; inf = no pacing
+    auto: bool = False
+    min_rtf: float = 0.25            # [sim s / wall s] auto never goes below
+    max_rtf: float = 100.0           # [sim s / wall s] auto never goes above (inf allowed)
+    max_lag: float = 0.15            # [simulated s] the worst node lag auto aims below
+    adjust_period: float = 0.25      # [wall s]
+    increase: float = 1.1            # factor per adjust_period while every node keeps up
+    forget_after: float = 2.0        # [wall s] a node silent this long no longer counts
+    heard: Dict[str, _Heard] = field(default_factory=dict)
+    achieved: float = 0.0            # [sim s / wall s] measured over the last adjust_period
+    worst: Tuple[str, float] = ('', 0.0)  # the node with the worst lag in the last period, and its lag
+    _mark: Optional[Tuple[float, float]] = None  # (wall, sim) at the last adjustment
+
+    def heartbeat(self, node: str, lag: float, wall: float) -> None:
+        """A node's heartbeat arrived at `wall` [s] with the clock `lag` [simulated s] past its stamp."""
+        h = self.heard.setdefault(node, _Heard())
+        if wall - h.last_wall > self.adjust_period:
+            h.lag = lag  # first beat of this period
+        else:
+            h.lag = max(h.lag, lag)
+        h.last_wall = wall
+
+    def restart(self, wall: float, sim: float) -> None:
+        """Time jumped (reset_simulation) or was paused: measure from here."""
+        self._mark = (wall, sim)
+
+    def update(self, wall: float, sim: float) -> bool:
+        """Call often with the wall and simulated time [s]; True when the factor was re-decided."""
+        if self._mark is None:
+            self._mark = (wall, sim)
+            return False
+        dw = wall - self._mark[0]
+        if dw < self.adjust_period:
+            return False
+        self.achieved = (sim - self._mark[1]) / dw
+        self._mark = (wall, sim)
+        live = {n: h for n, h in self.heard.items() if wall - h.last_wall <= self.forget_after}
+        self.worst = max(((n, h.lag) for n, h in live.items()), key=lambda t: t[1], default=('', 0.0))
+        for h in live.values():
+            h.lag = 0.0
+        if not self.auto:
+            return True
+        lag = self.worst[1]
+        current = self.rtf if math.isfinite(self.rtf) else max(self.achieved, self.min_rtf)
+        if lag > self.max_lag:
+            self.rtf = current * max(0.5, self.max_lag / lag)
+        elif lag < 0.5 * self.max_lag and self.achieved >= 0.8 * current:
+            # Raise only a factor that the simulator actually reaches, or it winds up far above.
+            self.rtf = current * self.increase
+        self.rtf = min(max(self.rtf, self.min_rtf), self.max_rtf)
+        return True
+
+
+def make_pacer(real_time_factor, min_rtf: float = 0.25, max_rtf: float = 100.0, max_lag: float = 0.15) -> Pacer:
+    """The pacer for the simulator's ~real_time_factor: a number >= 0 (0: as fast as possible) or
+    'auto' (start at 1x, within [min_rtf, max_rtf]). Raises PacingError naming the parameter."""
+    if not (min_rtf > 0 and max_rtf >= min_rtf):
+        raise PacingError('~min_real_time_factor must be > 0 and ~max_real_time_factor >= it (got %r, %r)'
+                          % (min_rtf, max_rtf))
+    if not max_lag > 0:
+        raise PacingError('~max_lag must be > 0 simulated seconds (got %r)' % max_lag)
+    if isinstance(real_time_factor, str) and real_time_factor.strip().lower() == AUTO:
+        return Pacer(rtf=min(max(1.0, min_rtf), max_rtf), auto=True, min_rtf=min_rtf, max_rtf=max_rtf,
+                     max_lag=max_lag)
+    try:
+        value = float(real_time_factor)
+    except (TypeError, ValueError):
+        raise PacingError('~real_time_factor must be a number >= 0 or "auto" (got %r)' % (real_time_factor,)) from None
+    if not value >= 0 or math.isnan(value):
+        raise PacingError('~real_time_factor must be a number >= 0 or "auto" (got %r)' % (real_time_factor,))
+    return Pacer(rtf=value if value > 0 else math.inf, auto=False, min_rtf=min_rtf, max_rtf=max_rtf, max_lag=max_lag)
