@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from mbot_slam_navigation import _core
-from mbot_slam_navigation.nav.frontiers import ExploreState, Frontier, Grid, frontier_groups, rank_frontiers
+from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, frontier_groups,
+                                                rank_frontiers)
 
 RES = 0.05
 
@@ -133,7 +134,7 @@ def test_failures_blacklist_expire_and_then_stick():
     assert s.avoid(71.0) == [] and not s.waiting_for_blacklist(71.0)  # expired: may be tried again
     s.choose(71.0, [a], (0.0, 0.0))
     s.fail(72.0)
-    assert s.avoid(1000.0) == [(1.0, 1.0)]                          # failed twice: for good
+    assert set(s.avoid(1000.0)) == {(1.0, 1.0)}                     # failed twice: for good
     assert not s.waiting_for_blacklist(1000.0)
 
 
@@ -173,3 +174,50 @@ def test_a_robot_inside_the_inscribed_zone_still_reaches_out_and_reachable_area_
     stats = {}
     assert rank_frontiers(m, c, (2.0, 2.2), escape_radius=0.0, stats=stats) == []  # without the escape: boxed in
     assert stats['reachable_m2'] < 0.01
+
+
+def test_a_failed_goal_is_not_sent_again_whatever_goal_its_frontier_yields_next():
+    # The door's frontier: its goal failed (the robot could not get there). Next time the frontier
+    # has grown and yields a goal 0.1 m from the failed one: neither that goal nor the frontier may
+    # be sent while blacklisted, and after max_tries the frontier is given up, with the reason.
+    m = room(door=(1.0, 2.0))
+    c = costmap_of(m)
+    s = ExploreState(blacklist_timeout=60.0, max_tries=2)
+    f = rank_frontiers(m, c, (2.0, 2.0))
+    assert s.choose(0.0, f, (2.0, 2.0)) is f[0]
+    s.fail(30.0, 'no progress for 30 s')
+    # without avoid, rank_frontiers yields the same goal again; with avoid_goals no goal within
+    # blacklist_radius of it
+    again = rank_frontiers(m, c, (2.0, 2.0), avoid_goals=s.avoid_goals(31.0), avoid_radius=s.blacklist_radius)
+    for g in again:
+        assert math.hypot(g.goal[0] - f[0].goal[0], g.goal[1] - f[0].goal[1]) >= s.blacklist_radius - RES
+    # the same frontier, grown by 0.5 m to the north and with its goal 0.1 m off: it waits
+    grown = Frontier(np.vstack([f[0].cells, f[0].cells[-10:] + [0.0, 0.5]]), f[0].size_m + 0.5,
+                     (f[0].goal[0], f[0].goal[1] + 0.1), f[0].path_m, f[0].cost)
+    eligible, waiting, given_up = s.screen(31.0, [grown])
+    assert (eligible, waiting, given_up) == ([], 1, [])
+    # far from it, another frontier is not held back
+    other = frontier_at(-5.0, -5.0)
+    assert s.screen(31.0, [grown, other])[0] == [other]
+    # after blacklist_timeout it may be tried once more; a second failure gives it up for good
+    eligible, waiting, _ = s.screen(91.0, [grown])
+    assert eligible == [grown] and waiting == 0
+    s.choose(91.0, [grown], (2.0, 2.0))
+    s.fail(121.0, 'move_base: no valid plan')
+    eligible, waiting, given_up = s.screen(1e6, [grown])
+    assert eligible == [] and waiting == 0 and len(given_up) == 1
+    assert 'move_base: no valid plan' in given_up[0].why and given_up[0].size_m == pytest.approx(grown.size_m)
+    assert not s.waiting_for_blacklist(1e6)
+
+
+def test_a_frontier_behind_a_gap_narrower_than_the_robot_is_reported_unreachable():
+    m = room(door=(1.0, 1.25))  # a 0.25 m gap; the robot's inscribed radius is 0.2 m
+    # what the laser saw through the gap: 1 m of floor beyond it, then unknown
+    m.data[int(1.5 / RES):int(2.75 / RES), int(5.0 / RES) + 1:int(6.0 / RES)] = 100
+    m.data[int(1.5 / RES) + 1:int(2.75 / RES) - 1, int(5.0 / RES) + 1:int(6.0 / RES)] = 0
+    c = costmap_of(m)
+    unreachable = []
+    assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.2, unreachable=unreachable) == []
+    assert len(unreachable) == 1 and isinstance(unreachable[0], GivenUp)
+    u = unreachable[0].as_dict()
+    assert u['x'] == pytest.approx(6.0, abs=0.1) and 'unreachable' in u['why']

@@ -4,10 +4,18 @@ Every 1/planner_frequency seconds: frontiers of the SLAM map, each one's goal = 
 the robot by path on move_base's global costmap (so never inside an obstacle, never unreachable),
 cost = potential_scale * path length - gain_scale * frontier size; the current goal is kept unless
 another beats it by `hysteresis`; a goal move_base aborts, or one the robot makes no progress
-towards within progress_timeout, is blacklisted for blacklist_timeout (after max_tries failures
-for good); a goal reached is not sent again. When no reachable frontier is left, the robot returns
-to its start pose, `explore/complete` (std_msgs/Bool, latched) turns true, and the report is
-written to ~report_dir if set (mbot_slam_navigation.explore_report).
+towards within progress_timeout, is blacklisted for blacklist_timeout with its frontier (after
+max_tries failures that frontier is given up, whatever goal it yields next); a goal reached is not
+sent again. Every run ends, with an outcome:
+- `complete`: no reachable frontier left (frontiers given up or unreachable are listed in the report);
+- `timeout`: max_duration [simulated s] passed (0: no limit);
+- `stuck`: goals fail, the robot has not moved for progress_timeout and move_base cannot move it;
+  the explorer then backs it out along its own recent path by cmd_vel, checking the laser (a
+  warning says so); if that fails twice, or the robot is boxed in with no path of its own, the
+  robot is stopped and the exploration ends.
+Then the robot returns to its start pose (not when stuck; within return_timeout), the report is
+written to ~report_dir if set (mbot_slam_navigation.explore_report), and `explore/complete`
+(std_msgs/Bool, latched) turns true.
 
 explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
 (move_base/global_costmap/costmap), planner_frequency (0.33 Hz), progress_timeout (30 s),
@@ -17,7 +25,9 @@ transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), ma
 hysteresis (1.0), min_unknown_area (3 m^2: enclosed unknown space smaller than this, the inside
 of furniture, makes no frontier), return_to_start (true), report_dir (''), world_name ('' = the simulator's
 /gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
-progress line), shutdown_when_done (false).
+progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
+scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
+escape_speed (0.1 m/s), escape_timeout (30 s).
 """
 import math
 import os
@@ -29,9 +39,10 @@ import rospy
 from actionlib import SimpleGoalState
 import tf2_ros
 from actionlib_msgs.msg import GoalStatus
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, Twist, Vector3
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid
+from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, ColorRGBA
 from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
@@ -39,7 +50,9 @@ from visualization_msgs.msg import Marker, MarkerArray
 from mbot_slam_navigation import explore_report
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
-from mbot_slam_navigation.nav.frontiers import ExploreState, Frontier, Grid, rank_frontiers
+from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
+from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, MotionWatch, Plateau,
+                                                rank_frontiers)
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
@@ -59,9 +72,9 @@ class Explore:
         r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
         self.base_frame = r.frame('robot_base_frame', 'base_footprint')
         self.global_frame = r.frame('global_frame', 'map')
-        costmap_topic = r.string('costmap_topic', 'move_base/global_costmap/costmap')
+        self.costmap_topic = costmap_topic = r.string('costmap_topic', 'move_base/global_costmap/costmap')
         r.string('costmap_updates_topic', '')  # explore_lite's; the full costmap topic is enough here
-        map_topic = r.string('map_topic', 'map')
+        self.map_topic = map_topic = r.string('map_topic', 'map')
         self.period = 1.0 / r.number('planner_frequency', 0.33, positive=True)
         self.potential_scale = r.number('potential_scale', 3.0, minimum=0.0)
         self.gain_scale = r.number('gain_scale', 1.0, minimum=0.0)
@@ -81,6 +94,13 @@ class Explore:
         self.robot_radius = r.number('robot_radius', 0.2, positive=True)
         self.progress_period = r.number('progress_period', 10.0, positive=True)
         self.shutdown_when_done = r.boolean('shutdown_when_done', False)
+        self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
+        self.return_timeout = r.number('return_timeout', 120.0, positive=True)
+        self.escape_distance = r.number('escape_distance', 0.6, positive=True)
+        self.escape_speed = r.number('escape_speed', 0.1, positive=True)
+        self.escape_timeout = r.number('escape_timeout', 30.0, positive=True)
+        scan_topic = r.string('scan_topic', 'scan')
+        cmd_vel_topic = r.string('cmd_vel_topic', 'cmd_vel')
         r.report_unknown()
 
         self.map: Optional[Grid] = None
@@ -90,11 +110,17 @@ class Explore:
         self.path: List[Tuple[float, float]] = []
         self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
         self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
+        self.given_up: List[GivenUp] = []
+        self.motion = MotionWatch(self.state.progress_distance)
+        self.plateau = Plateau()
+        self.scan: Optional[LaserScan] = None
         self.tf = tf2_ros.Buffer()
         self.tf_listener = tf2_ros.TransformListener(self.tf)
         rospy.Subscriber(map_topic, OccupancyGrid, self.on_map, queue_size=1, buff_size=2 ** 24)
         rospy.Subscriber(costmap_topic, OccupancyGrid, self.on_costmap, queue_size=1, buff_size=2 ** 24)
         rospy.Subscriber('/gazebo/contacts', Contact, self.on_contact)
+        rospy.Subscriber(scan_topic, LaserScan, self.on_scan, queue_size=1)
+        self.cmd_pub = rospy.Publisher(cmd_vel_topic, Twist, queue_size=1)  # only while backing out
         self.marker_pub = rospy.Publisher('explore/frontiers', MarkerArray, queue_size=1, latch=True)
         self.done_pub = rospy.Publisher('explore/complete', Bool, queue_size=1, latch=True)
         self.done_pub.publish(Bool(False))
@@ -107,6 +133,9 @@ class Explore:
 
     def on_costmap(self, msg: OccupancyGrid) -> None:
         self.costmap = grid_of(msg)
+
+    def on_scan(self, msg: LaserScan) -> None:
+        self.scan = msg
 
     def on_contact(self, msg: Contact) -> None:
         self.collisions += 1
@@ -168,104 +197,221 @@ class Explore:
             out.markers += [cells, goal]
         self.marker_pub.publish(out)
 
-    def finish_goal(self, now: float) -> None:
-        """Takes in move_base's result for the current goal, if it has one."""
+    def finish_goal(self, now: float) -> bool:
+        """Takes in move_base's result for the current goal, if it has one; True if it failed."""
         if self.state.goal is None or self.move_base.simple_state != SimpleGoalState.DONE:
-            return
+            return False
         gx, gy = self.state.goal.goal
         if self.move_base.get_state() == GoalStatus.SUCCEEDED:
             self.goals.append((gx, gy, True))
             self.state.reached(now)
-        else:
-            self.goals.append((gx, gy, False))
-            rospy.logwarn('explore: move_base gave up on (%.2f, %.2f): %s; blacklisted for %.0f s', gx, gy,
-                          self.move_base.get_goal_status_text(), self.state.blacklist_timeout)
-            self.state.fail(now)
+            return False
+        self.goals.append((gx, gy, False))
+        text = self.move_base.get_goal_status_text()
+        rospy.logwarn('explore: move_base gave up on (%.2f, %.2f): %s; blacklisted for %.0f s', gx, gy, text,
+                      self.state.blacklist_timeout)
+        self.state.fail(now, 'move_base: %s' % text)
+        return True
 
     def run(self) -> None:
         rospy.loginfo('explore: waiting for move_base, the map and the global costmap...')
+        waited = time.monotonic()
         while not self.move_base.wait_for_server(rospy.Duration(5.0)) and not rospy.is_shutdown():
-            rospy.logwarn_throttle(30.0, 'explore: no move_base action server yet on %s' % rospy.resolve_name('move_base'))
+            rospy.logwarn_throttle(30.0, 'explore: no move_base action server yet on %s (%.0f s)'
+                                   % (rospy.resolve_name('move_base'), time.monotonic() - waited))
         start = None
         while not rospy.is_shutdown() and (self.map is None or self.costmap is None or start is None):
             start = self.robot_pose()
             rospy.sleep(0.5)
+            if time.monotonic() - waited > 20.0:
+                rospy.logwarn_throttle(30.0, 'explore: still waiting: %s' % ', '.join(
+                    what for what, missing in (('a map on %s' % self.map_topic, self.map is None),
+                                               ('a costmap on %s' % self.costmap_topic, self.costmap is None),
+                                               ('the robot pose', start is None)) if missing))
         if rospy.is_shutdown():
             return
         self.start_time = rospy.Time.now()
         wall0 = time.monotonic()
         rospy.Timer(rospy.Duration(0.5), self.record_path)
         rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
-        next_print, empty_cycles = 0.0, 0
+        outcome = self.explore(wall0)
+        if outcome is not None:
+            self.finish(outcome, start, wall0)
+
+    def explore(self, wall0: float) -> Optional[str]:
+        """Sends frontier goals until the outcome is decided: 'complete', 'timeout' or 'stuck' (None
+        on shutdown)."""
+        next_print, empty_cycles, escapes_failed = 0.0, 0, 0
+        boxed_since: Optional[float] = None
         while not rospy.is_shutdown():
-            now = (rospy.Time.now() - self.start_time).to_sec()
+            now = self.elapsed()
+            if self.max_duration > 0 and now >= self.max_duration:
+                rospy.logwarn('explore: max_duration %.0f s reached with frontiers left; ending the exploration'
+                              % self.max_duration)
+                return 'timeout'
             pose = self.robot_pose()
             if pose is None:
                 rospy.sleep(self.period)
                 continue
-            self.finish_goal(now)
+            self.motion.update(now, pose[:2])
+            failed = self.finish_goal(now)
             goal = self.state.goal
             if self.state.stuck(now, pose[:2]):
                 self.goals.append((goal.goal[0], goal.goal[1], False))
-                rospy.logwarn('explore: no progress for %.0f s; goal blacklisted', self.state.progress_timeout)
+                rospy.logwarn('explore: no progress towards (%.2f, %.2f) for %.0f s; goal blacklisted for %.0f s'
+                              % (goal.goal[0], goal.goal[1], self.state.progress_timeout, self.state.blacklist_timeout))
                 self.move_base.cancel_goal()
+                failed = True
+            if failed and self.motion.still_for(now) >= self.state.progress_timeout:
+                # Goals fail and the robot has not moved: move_base cannot turn or back it out.
+                if self.escape(pose):
+                    escapes_failed = 0
+                else:
+                    escapes_failed += 1
+                    if escapes_failed >= 2:
+                        return 'stuck'
+                continue
             stats = {}
-            frontiers = rank_frontiers(self.map, self.costmap, pose[:2], self.min_frontier_size,
-                                       self.potential_scale, self.gain_scale, self.state.avoid(now),
-                                       self.state.blacklist_radius, min_unknown_area=self.min_unknown_area,
-                                       stats=stats)
+            unreachable: List[GivenUp] = []
+            ranked = rank_frontiers(self.map, self.costmap, pose[:2], self.min_frontier_size, self.potential_scale,
+                                    self.gain_scale, self.state.avoid(now), self.state.blacklist_radius,
+                                    min_unknown_area=self.min_unknown_area, stats=stats,
+                                    avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
+            frontiers, waiting, given_up = self.state.screen(now, ranked)
+            self.given_up = given_up + unreachable
             self.publish_markers(frontiers)
+            self.plateau.update(now, explore_report.known_area(self.map), bool(frontiers) or self.state.goal is not None)
             new = self.state.choose(now, frontiers, pose[:2])
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
                 self.send(new.goal[0], new.goal[1], yaw)
                 rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m; %d frontiers', new.goal[0],
                               new.goal[1], new.path_m, new.size_m, len(frontiers))
+            reachable_m2 = stats.get('reachable_m2', 0.0)
             if frontiers or self.state.goal is not None:
-                empty_cycles = 0
-            elif self.state.waiting_for_blacklist(now):
-                rospy.loginfo_throttle(30.0, 'explore: only blacklisted frontiers left; waiting to retry them')
-            elif stats.get('reachable_m2', 0.0) < BOXED_IN_M2:
-                # Not done: the robot is boxed in by its costmap (an obstacle seen beside it, a
-                # stale costmap); move_base's recoveries or the next costmap will free it.
-                rospy.logwarn_throttle(30.0, 'explore: the robot can reach only %.1f m^2 on the global costmap; '
-                                             'clearing the costmaps' % stats.get('reachable_m2', 0.0))
-                self.clear_costmaps()
+                empty_cycles, boxed_since = 0, None
+            elif waiting:
+                rospy.loginfo_throttle(30.0, 'explore: %d frontier(s) blacklisted for now; waiting to retry them' % waiting)
+            elif reachable_m2 < BOXED_IN_M2:
+                # Not done: the robot is boxed in on its costmap (an obstacle seen beside it, a stale
+                # costmap). Clearing the costmaps frees it if the obstacle is gone; if not within
+                # progress_timeout, it backs out along its own path; if it cannot, it is stuck.
+                if boxed_since is None:
+                    boxed_since = now
+                    rospy.logwarn('explore: the robot can reach only %.1f m^2 on the global costmap; clearing the '
+                                  'costmaps' % reachable_m2)
+                    self.clear_costmaps()
+                elif now - boxed_since >= self.state.progress_timeout:
+                    if not self.escape(pose):
+                        rospy.logerr('explore: the robot is boxed in: it can reach %.2f m^2 and cannot back out'
+                                     % reachable_m2)
+                        return 'stuck'
+                    boxed_since = None
             else:
                 empty_cycles += 1  # twice in a row, so that one odd costmap does not end it
                 if empty_cycles >= 2:
-                    break
+                    return 'complete'
             if now >= next_print:
                 next_print = now + self.progress_period
                 print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
                       'wall' % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
                                 self.goals_failed(), now, time.monotonic() - wall0), flush=True)
             rospy.sleep(self.period)
-        if rospy.is_shutdown():
-            return
-        self.complete(start, wall0)
+        return None
 
-    def complete(self, start, wall0) -> None:
-        t_explored = (rospy.Time.now() - self.start_time).to_sec()
-        rospy.loginfo('explore: no reachable frontier left after %.0f s; exploration complete', t_explored)
+    def elapsed(self) -> float:
+        """[s] simulated (ROS) time since the exploration started."""
+        return (rospy.Time.now() - self.start_time).to_sec()
+
+    def escape(self, pose) -> bool:
+        """Backs the robot out along its own recent path (it drove in, so that way was free),
+        driving by cmd_vel and checking the laser, not the costmap that has it boxed in. True if it
+        got escape_distance out."""
         self.move_base.cancel_goal()
-        if self.return_to_start:
+        target = backtrack_target(self.path, pose[:2], self.escape_distance)
+        if target is None:
+            rospy.logerr('explore: the robot at (%.2f, %.2f) cannot move and has no path of its own to back out along'
+                         % pose[:2])
+            return False
+        rospy.logwarn('explore: the robot at (%.2f, %.2f) made no progress for %.0f s and move_base cannot move it; '
+                      'backing out along its own path to (%.2f, %.2f)' % (pose[0], pose[1], self.motion.still_for(
+                          self.elapsed()), target[0], target[1]))
+        ok, why = self.drive_to(target)
+        self.cmd_pub.publish(Twist())
+        if ok:
+            rospy.logwarn('explore: backed out to (%.2f, %.2f); exploring on' % target)
+            self.clear_costmaps()
+            self.motion.reset(self.elapsed(), target)
+        else:
+            rospy.logerr('explore: could not back out: %s' % why)
+        return ok
+
+    def drive_to(self, target: Tuple[float, float]) -> Tuple[bool, str]:
+        """Drives straight for `target` (map frame), forwards or backwards, whichever faces it."""
+        rate = rospy.Rate(10.0)
+        t_end = self.elapsed() + self.escape_timeout
+        start = None
+        while not rospy.is_shutdown() and self.elapsed() < t_end:
+            pose = self.robot_pose()
+            if pose is None:
+                rate.sleep()
+                continue
+            start = start or pose[:2]
+            cmd, why = escape_command(pose, target, self.scan_points(), self.robot_radius, self.escape_speed)
+            if cmd is None:
+                return why == 'arrived', why
+            self.cmd_pub.publish(Twist(linear=Vector3(cmd[0], 0.0, 0.0), angular=Vector3(0.0, 0.0, cmd[1])))
+            rate.sleep()
+        return False, 'did not get there within %.0f s' % self.escape_timeout
+
+    def scan_points(self) -> np.ndarray:
+        """(N, 2) [m] the latest scan's returns in the robot's base frame (empty if none)."""
+        msg = self.scan
+        if msg is None:
+            return np.zeros((0, 2))
+        try:
+            t = self.tf.lookup_transform(self.base_frame, msg.header.frame_id, rospy.Time(0), rospy.Duration(0.1))
+        except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException):
+            return np.zeros((0, 2))
+        r = np.asarray(msg.ranges, float)
+        a = msg.angle_min + msg.angle_increment * np.arange(len(r))
+        ok = np.isfinite(r) & (r >= msg.range_min) & (r <= msg.range_max)
+        q = t.transform.rotation
+        yaw = quaternion_to_yaw(q.x, q.y, q.z, q.w)
+        x = t.transform.translation.x + r[ok] * np.cos(a[ok] + yaw)
+        y = t.transform.translation.y + r[ok] * np.sin(a[ok] + yaw)
+        return np.column_stack([x, y])
+
+    def finish(self, outcome: str, start, wall0: float) -> None:
+        t_explored = self.elapsed()
+        self.move_base.cancel_goal()
+        if outcome == 'complete':
+            rospy.loginfo('explore: no reachable frontier left after %.0f s; exploration complete', t_explored)
+        if outcome == 'stuck':
+            self.cmd_pub.publish(Twist())
+            rospy.logerr('explore: the robot is stuck at %s; the exploration ends here' % (self.robot_pose(),))
+        elif self.return_to_start:
             rospy.loginfo('explore: returning to the start pose (%.2f, %.2f)', start[0], start[1])
             self.send(*start)
-            self.move_base.wait_for_result(rospy.Duration(180.0))
+            if not self.move_base.wait_for_result(rospy.Duration(self.return_timeout)):
+                rospy.logwarn('explore: not back at the start after %.0f s; stopping there' % self.return_timeout)
+                self.move_base.cancel_goal()
             pose = self.robot_pose()
             if pose is not None:
                 self.path.append(pose[:2])
         distance = float(np.sum(np.hypot(*np.diff(np.array(self.path), axis=0).T))) if len(self.path) > 1 else 0.0
         figures = {
-            'outcome': 'complete',
+            'outcome': outcome,
             'exploration_time_s': round(t_explored, 1),
-            'total_time_s': round((rospy.Time.now() - self.start_time).to_sec(), 1),
+            'total_time_s': round(self.elapsed(), 1),
             'wall_time_s': round(time.monotonic() - wall0, 1),
             'distance_m': round(distance, 2),
             'goals_sent': self.state.goals_chosen,
             'goals_failed': self.goals_failed(),
             'collisions': self.collisions,
+            'longest_plateau_s': round(self.plateau.longest, 1),
+            'longest_plateau_at_s': round(self.plateau.longest_at, 1),
+            'given_up': [g.as_dict() for g in self.given_up],
         }
         if self.report_dir and self.map is not None:
             world = None
@@ -276,8 +422,11 @@ class Explore:
             print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
                   % os.path.abspath(self.report_dir), flush=True)
         for k, v in figures.items():
-            print('  %-28s %s' % (k, v), flush=True)
-        rospy.loginfo('explore: exploration complete: %s', figures)
+            if k != 'given_up':
+                print('  %-28s %s' % (k, v), flush=True)
+        for g in figures['given_up']:
+            print('  given up: (%.2f, %.2f), %.1f m: %s' % (g['x'], g['y'], g['size_m'], g['why']), flush=True)
+        rospy.loginfo('explore: exploration ended (%s): %s', outcome, figures)
         self.done_pub.publish(Bool(True))  # last, so that the report is on disk when it says so
 
 

@@ -51,6 +51,18 @@ class Frontier:
     cost: float              # potential_scale * path_m - gain_scale * size_m (lower is better)
 
 
+@dataclass
+class GivenUp:
+    """A frontier the explorer will not send the robot to, and why (for the report)."""
+    x: float                 # [m] centroid of its cells, map frame
+    y: float
+    size_m: float
+    why: str
+
+    def as_dict(self) -> dict:
+        return {'x': round(self.x, 2), 'y': round(self.y, 2), 'size_m': round(self.size_m, 2), 'why': self.why}
+
+
 def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> List[np.ndarray]:
     """The frontiers of map m as arrays of (row, col), largest first.
 
@@ -94,14 +106,17 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                    potential_scale: float = 3.0, gain_scale: float = 1.0, avoid: Sequence[Tuple[float, float]] = (),
                    avoid_radius: float = 0.6, goal_reach: float = 0.4, goal_cost_max: int = 50,
                    occupied_min: int = 65, min_unknown_area: float = 0.0, escape_radius: float = 0.35,
-                   stats: Optional[dict] = None) -> List[Frontier]:
+                   stats: Optional[dict] = None, avoid_goals: Sequence[Tuple[float, float]] = (),
+                   unreachable: Optional[List[GivenUp]] = None) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
     visited) do not count. A frontier's goal is the costmap cell nearest to the robot by path among
     those within goal_reach [m] of its cells with a cost below goal_cost_max (OccupancyGrid scale,
     0..100: clear of the inflated zone, so move_base will not refuse it as occupied when the
-    obstacle behind the frontier shows up).
+    obstacle behind the frontier shows up), and not within avoid_radius of a point in
+    `avoid_goals` (goals that failed: whatever shape the frontier has now, that goal is not sent
+    again). Frontiers large enough but with no such cell are appended to `unreachable`.
     """
     rr, rc = costmap.cell_of(robot[0], robot[1])
     if not costmap.inside(rr, rc):
@@ -117,6 +132,14 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     if stats is not None:
         stats['reachable_m2'] = float(np.count_nonzero(dist >= 0)) * costmap.resolution ** 2
     goal_ok = (dist >= 0) & open_cells & (cost < goal_cost_max)
+    avoid_goals = np.asarray(avoid_goals, float).reshape(-1, 2)
+    if len(avoid_goals):
+        blocked = np.zeros(cost.shape, np.uint8)
+        r = max(1, int(round(avoid_radius / costmap.resolution)))
+        for gx, gy in avoid_goals:
+            br, bc = costmap.cell_of(gx, gy)
+            cv2.circle(blocked, (int(bc), int(br)), r, 1, -1)
+        goal_ok &= blocked == 0
     k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1
     disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
     avoid = np.asarray(avoid, float).reshape(-1, 2)
@@ -131,12 +154,14 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             continue
         cr, cc = costmap.cell_of(x, y)
         inside = costmap.inside(cr, cc)
-        if not inside.any():
-            continue
         near = np.zeros(cost.shape, np.uint8)
         near[cr[inside], cc[inside]] = 1
         candidates = (cv2.dilate(near, disc) > 0) & goal_ok
         if not candidates.any():
+            if unreachable is not None:
+                unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
+                                           'unreachable: no cell within %.1f m of it that the robot can reach clear '
+                                           'of obstacles on the global costmap' % goal_reach))
             continue
         d = np.where(candidates, dist, np.inf)
         gr, gc = np.unravel_index(int(np.argmin(d)), d.shape)
@@ -149,10 +174,28 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
 
 @dataclass
 class Blacklisted:
-    x: float
-    y: float
-    until: float   # [s] when it may be tried again
-    tries: int     # how many times a goal here failed
+    """A place not to send the robot to: a goal reached (for good), or goals that failed on one
+    frontier (until `until`, for good after max_tries)."""
+    goals: List[Tuple[float, float]]  # [m] the goals sent there (map frame)
+    until: float                      # [s] when it may be tried again
+    tries: int                        # how many times a goal here failed
+    cells: Optional[np.ndarray] = None  # (N, 2) [m] the frontier's cells when its goals failed; None: reached
+    size_m: float = 0.0
+    why: str = ''                     # the last failure's reason
+
+
+def _near_fraction(a: np.ndarray, b: np.ndarray, distance: float) -> float:
+    """Fraction of the points of a within `distance` [m] of some point of b."""
+    if len(a) == 0 or len(b) == 0:
+        return 0.0
+    step = max(1, len(b) // 400)  # a subsample of b is enough at cell spacing; bounds the cost
+    bb = b[::step]
+    near = np.zeros(len(a), bool)
+    for i in range(0, len(a), 512):
+        chunk = a[i:i + 512]
+        d2 = (chunk[:, None, 0] - bb[None, :, 0]) ** 2 + (chunk[:, None, 1] - bb[None, :, 1]) ** 2
+        near[i:i + 512] = d2.min(axis=1) <= (distance + step * 0.05) ** 2
+    return float(near.mean())
 
 
 @dataclass
@@ -163,6 +206,7 @@ class ExploreState:
     blacklist_timeout: float = 60.0   # [s] before a failed goal may be tried again
     max_tries: int = 2                # failures after which a place stays blacklisted
     blacklist_radius: float = 0.6     # [m] around a failed or visited goal
+    same_frontier_overlap: float = 0.5  # fraction of cells within 0.3 m that makes two frontiers one
     hysteresis: float = 1.0           # [cost] a new frontier must beat the current goal's by this
     goal: Optional[Frontier] = None
     progress_at: Tuple[float, float] = (math.nan, math.nan)
@@ -171,11 +215,45 @@ class ExploreState:
     goals_chosen: int = 0             # new goals (a goal that moved with its frontier is not new)
 
     def avoid(self, now: float) -> List[Tuple[float, float]]:
-        return [(b.x, b.y) for b in self.blacklist if b.until > now or b.tries >= self.max_tries]
+        """Places whose frontier cells do not count now (rank_frontiers' avoid)."""
+        return [g for b in self.blacklist if b.until > now or b.tries >= self.max_tries for g in b.goals]
+
+    def avoid_goals(self, now: float) -> List[Tuple[float, float]]:
+        """Goals that failed and may not be sent now (rank_frontiers' avoid_goals)."""
+        return [g for b in self.blacklist if b.cells is not None and (b.until > now or b.tries >= self.max_tries)
+                for g in b.goals]
 
     def waiting_for_blacklist(self, now: float) -> bool:
         """True while some place may still be tried again later."""
         return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
+
+    def _same_place(self, b: Blacklisted, f: Frontier) -> bool:
+        if any(math.hypot(f.goal[0] - x, f.goal[1] - y) < self.blacklist_radius for x, y in b.goals):
+            return True
+        if b.cells is None:
+            return False
+        return (_near_fraction(f.cells, b.cells, 0.3) >= self.same_frontier_overlap or
+                _near_fraction(b.cells, f.cells, 0.3) >= self.same_frontier_overlap)
+
+    def screen(self, now: float, frontiers: List[Frontier]) -> Tuple[List[Frontier], int, List[GivenUp]]:
+        """(frontiers that may be sent now, how many wait for their blacklist to expire, those given
+        up for good) by the failures recorded: a frontier that is the place of a failed goal (its
+        goal near that goal, or most of its cells near the failed frontier's cells, however it has
+        grown or shrunk since) waits blacklist_timeout, and is given up after max_tries failures."""
+        eligible, waiting, given_up = [], 0, []
+        failures = [b for b in self.blacklist if b.cells is not None]
+        for f in frontiers:
+            matches = [b for b in failures if self._same_place(b, f)]
+            exhausted = [b for b in matches if b.tries >= self.max_tries]
+            if exhausted:
+                x, y = f.cells.mean(axis=0)
+                given_up.append(GivenUp(float(x), float(y), f.size_m, '%d goals failed (last: %s)'
+                                        % (exhausted[0].tries, exhausted[0].why)))
+            elif any(b.until > now for b in matches):
+                waiting += 1
+            else:
+                eligible.append(f)
+        return eligible, waiting, given_up
 
     def choose(self, now: float, frontiers: List[Frontier], robot: Tuple[float, float]) -> Optional[Frontier]:
         """The frontier to head for (a goal to send), or None to keep the current goal; with no
@@ -217,27 +295,68 @@ class ExploreState:
             self.progress_at, self.progress_time = robot, now
             return False
         if now - self.progress_time > self.progress_timeout:
-            self.fail(now)
+            self.fail(now, 'no progress for %.0f s' % self.progress_timeout)
             return True
         return False
 
-    def fail(self, now: float) -> None:
-        """The current goal failed (aborted by move_base, or no progress): blacklist its place."""
+    def fail(self, now: float, why: str = '') -> None:
+        """The current goal failed (aborted by move_base, or no progress): blacklist its place and
+        its frontier."""
         if self.goal is None:
             return
-        gx, gy = self.goal.goal
+        f = self.goal
         for b in self.blacklist:
-            if math.hypot(b.x - gx, b.y - gy) < self.blacklist_radius:
+            if b.cells is not None and self._same_place(b, f):
                 b.tries += 1
                 b.until = now + self.blacklist_timeout
+                b.goals.append(f.goal)
+                b.cells = np.concatenate([b.cells, f.cells])
+                b.size_m, b.why = f.size_m, why
                 break
         else:
-            self.blacklist.append(Blacklisted(gx, gy, now + self.blacklist_timeout, 1))
+            self.blacklist.append(Blacklisted([f.goal], now + self.blacklist_timeout, 1, f.cells.copy(), f.size_m, why))
         self.goal = None
 
     def reached(self, now: float) -> None:
         """The goal was reached: its place is not sent again (a frontier still there cannot be seen
         from it, e.g. unknown space under furniture)."""
         if self.goal is not None:
-            self.blacklist.append(Blacklisted(self.goal.goal[0], self.goal.goal[1], now, self.max_tries))
+            self.blacklist.append(Blacklisted([self.goal.goal], now, self.max_tries))
         self.goal = None
+
+
+@dataclass
+class MotionWatch:
+    """How long the robot has stood still (moved less than `distance` [m]), whatever its goals."""
+    distance: float = 0.2
+    anchor: Optional[Tuple[float, float]] = None
+    since: float = 0.0
+
+    def update(self, now: float, robot: Tuple[float, float]) -> None:
+        if self.anchor is None or math.hypot(robot[0] - self.anchor[0], robot[1] - self.anchor[1]) >= self.distance:
+            self.reset(now, robot)
+
+    def reset(self, now: float, robot: Tuple[float, float]) -> None:
+        self.anchor, self.since = robot, now
+
+    def still_for(self, now: float) -> float:
+        return now - self.since if self.anchor is not None else 0.0
+
+
+@dataclass
+class Plateau:
+    """The longest stretch [s] without new explored area while reachable frontiers remained."""
+    growth: float = 0.5         # [m^2] of new known area that ends a plateau
+    longest: float = 0.0        # [s]
+    longest_at: float = 0.0     # [s] when that stretch began
+    _mark: Optional[Tuple[float, float]] = None  # (time, known area) at the last growth
+
+    def update(self, now: float, known_m2: float, frontiers_left: bool) -> None:
+        if not frontiers_left:
+            self._mark = None
+            return
+        if self._mark is None or known_m2 >= self._mark[1] + self.growth:
+            self._mark = (now, known_m2)
+            return
+        if now - self._mark[0] > self.longest:
+            self.longest, self.longest_at = now - self._mark[0], self._mark[0]

@@ -1,0 +1,93 @@
+"""Runs a whole exploration (roslaunch of launch/explore.launch or another launch file with an
+explore node) until the explorer has written its report, then shuts the launch down cleanly and
+prints one line with the outcome. Exit status 0 only for outcome `complete`; 2 if there is no
+report (roslaunch ended first, or the wall-clock limit passed).
+
+Why not `required="true"` on the explorer: roslaunch then ends with a "REQUIRED process has died"
+banner, which reads as a crash at the end of every successful run.
+"""
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from typing import List, Optional
+
+
+def report_dir_of(launch_args: List[str]) -> Optional[str]:
+    for a in launch_args:
+        if a.startswith('report_dir:='):
+            return os.path.abspath(a.split(':=', 1)[1])
+    return None
+
+
+def stop(proc: subprocess.Popen, grace_s: float = 30.0) -> int:
+    """SIGINT (roslaunch's Ctrl-C), then SIGTERM and SIGKILL if it does not end in time."""
+    for sig, wait in ((signal.SIGINT, grace_s), (signal.SIGTERM, 10.0), (signal.SIGKILL, 10.0)):
+        if proc.poll() is not None:
+            break
+        proc.send_signal(sig)
+        try:
+            proc.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            continue
+    return proc.wait()
+
+
+def summary(r: dict, report_dir: str) -> str:
+    line = 'exploration: %s after %.0f s simulated (%.0f s wall)' % (r.get('outcome'), r.get('exploration_time_s', 0),
+                                                                     r.get('wall_time_s', 0))
+    if 'coverage_of_reachable_free' in r:
+        line += ', %.1f%% of the reachable free space, walls %.1f%% within 0.1 m' % (
+            100 * r['coverage_of_reachable_free'], 100 * r['walls_within_tolerance'])
+    line += ', %d collisions, %d given up; report in %s' % (r.get('collisions', 0), len(r.get('given_up', [])),
+                                                             report_dir)
+    return line
+
+
+def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Optional[dict]:
+    """Runs `roslaunch <launch...>` until report.json appears in its report_dir; the report or None."""
+    report_dir = report_dir_of(launch)
+    if report_dir is None:
+        raise SystemExit('run_exploration: pass report_dir:=DIR among the roslaunch arguments')
+    report = os.path.join(report_dir, 'report.json')
+    if os.path.exists(report):
+        os.remove(report)  # a report from an earlier run must not end this one at once
+    proc = subprocess.Popen(['roslaunch'] + launch, env=env, stdout=stdout, stderr=subprocess.STDOUT if stdout else None)
+    t0 = time.monotonic()
+    try:
+        while not os.path.exists(report):
+            if proc.poll() is not None:
+                print('run_exploration: roslaunch ended (exit %d) before the explorer wrote %s' % (proc.returncode,
+                                                                                                  report), flush=True)
+                return None
+            if time.monotonic() - t0 > wall_timeout:
+                print('run_exploration: no report after %.0f s of wall time; stopping the launch' % wall_timeout,
+                      flush=True)
+                return None
+            time.sleep(1.0)
+        time.sleep(1.0)  # the explorer's last lines
+        with open(report) as f:
+            return json.load(f)
+    finally:
+        stop(proc)
+
+
+def main(argv=None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    p.add_argument('--wall-timeout', type=float, default=3600.0, help='[s] of wall time before giving up')
+    p.add_argument('launch', nargs=argparse.REMAINDER, help='roslaunch arguments: PKG FILE.launch [arg:=value ...]')
+    a = p.parse_args(argv)
+    if a.launch[:1] == ['--']:
+        a.launch = a.launch[1:]
+    try:
+        r = run(a.launch, a.wall_timeout)
+    except KeyboardInterrupt:
+        print('run_exploration: interrupted', flush=True)
+        sys.exit(130)
+    if r is None:
+        sys.exit(2)
+    print(summary(r, report_dir_of(a.launch)), flush=True)
+    sys.exit(0 if r.get('outcome') == 'complete' else 1)

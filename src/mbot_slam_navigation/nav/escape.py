@@ -1,0 +1,48 @@
+"""Getting a stuck robot out, ROS-free: the explorer's last resort when move_base's recoveries cannot
+turn or back the robot (its costmap has it boxed in). The robot drove in, so its own recent path
+is a way out: it drives straight back to a point of that path, forwards or backwards, whichever
+faces the point, and checks its laser (the truth) rather than the costmap.
+
+Poses are (x, y, yaw) [m, rad] in the map frame; scan points (x, y) [m] in the robot's base frame.
+"""
+import math
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+
+def backtrack_target(path: Sequence[Tuple[float, float]], robot: Tuple[float, float],
+                     distance: float) -> Optional[Tuple[float, float]]:
+    """The point of the driven path (oldest first), walking back from its end, that is first
+    `distance` [m] from the robot in a straight line; None if the path never gets that far."""
+    for x, y in reversed(list(path)):
+        if math.hypot(x - robot[0], y - robot[1]) >= distance:
+            return float(x), float(y)
+    return None
+
+
+def escape_command(pose: Tuple[float, float, float], target: Tuple[float, float], points: np.ndarray,
+                   radius: float, speed: float, arrive: float = 0.1, clearance: float = 0.02,
+                   lookahead: float = 0.1) -> Tuple[Optional[Tuple[float, float]], str]:
+    """((v [m/s], w [rad/s]), '') to drive for target, or (None, 'arrived') / (None, why blocked).
+
+    The robot (a disc of `radius`) goes forwards if the target is ahead, else backwards, turning
+    towards it as it goes (never in place: turning in place is what the robot could not do). It is
+    blocked when a laser point lies within radius + clearance of where it would be after
+    `lookahead` metres, on the side it moves to."""
+    dx, dy = target[0] - pose[0], target[1] - pose[1]
+    if math.hypot(dx, dy) < arrive:
+        return None, 'arrived'
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    tx, ty = c * dx + s * dy, -s * dx + c * dy  # target in the base frame
+    direction = 1.0 if tx >= 0 else -1.0
+    error = math.atan2(ty * direction, tx * direction)  # heading error of the travel direction
+    w = max(-0.5, min(0.5, 1.5 * error))  # turns the travel direction (backwards too) towards it
+    v = direction * speed * max(0.3, math.cos(error))
+    pts = np.asarray(points, float).reshape(-1, 2)
+    if len(pts):
+        ahead = pts[:, 0] * direction > 0
+        d = np.hypot(pts[:, 0] - direction * lookahead, pts[:, 1])
+        if np.any(ahead & (d < radius + clearance)):
+            return None, 'the laser sees an obstacle %s the robot' % ('in front of' if direction > 0 else 'behind')
+    return (v, w), ''
