@@ -1,77 +1,106 @@
 #!/usr/bin/env python3
-"""Autonomous exploration of the home, end to end: launch/explore.launch (simulator, slam_gmapping,
-move_base, explore) at 4x real time, RUNS times; each run's report (bench/out/explore_N/) gives the
-figures, printed as the median over runs with every run listed. Targets (issue 8): complete within
-600 s simulated, >= 97% of the reachable free space, every wall within 0.1 m, no collision.
-Run inside the devel environment (make bench does that); about 3 min wall per run here.
+"""Autonomous exploration end to end, per world: launch/explore.launch (simulator at
+real_time_factor auto, slam_gmapping, move_base, explore) run by run_exploration until the
+explorer's report, RUNS times per world, on a quiet machine and again with one extra busy process
+(a process spinning on one core, as a user's other work would). Prints per world and load:
+completions, median and worst exploration time, coverage, walls, collisions, longest plateau
+(without new explored area while reachable frontiers remained), wall time; every run's report is
+kept in bench/out/explore_<world>_<load>_<k>/.
+
+Environment: BENCH_EXPLORE_WORLDS (comma-separated, default home,office,apartment,large),
+BENCH_EXPLORE_RUNS (default 5 for the home, 2 elsewhere), BENCH_EXPLORE_LOADS (quiet,busy).
+Targets (issue 16): every run complete, coverage >= 97%, walls >= 99% within 0.1 m, 0 collisions;
+median exploration <= 360 s (home), <= 600 s (office), <= 1500 s (large); plateau <= 60 s.
+Run inside the devel environment (make bench does that). Takes hours with the defaults.
 """
 import json
+import multiprocessing
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import time
 
+from mbot_slam_navigation.exploration_run import run
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-RUNS = int(os.environ.get('BENCH_EXPLORE_RUNS', '3'))
+PKG = os.path.abspath(os.path.join(HERE, '..'))
 PORT = 11398
+WORLDS = {
+    'home': ('mbot_sim_gazebo_navigation.world', 360.0),
+    'office': ('office.world', 600.0),
+    'apartment': ('apartment.world', 600.0),
+    'large': ('large.world', 1500.0),
+}
 
 
-def emit(metric, values, unit, target='', fmt='%.3g'):
-    note = 'runs: ' + ', '.join(fmt % v for v in values)
-    print(json.dumps({'benchmark': 'explore', 'metric': metric, 'value': statistics.median(values), 'unit': unit,
-                      'target': target, 'note': note}), flush=True)
+def spin(stop_at):
+    while time.time() < stop_at:
+        pass
 
 
-def one_run(k):
-    out = os.path.join(HERE, 'out', 'explore_%d' % k)
+def one_run(world, load, k, log_dir):
+    out = os.path.join(HERE, 'out', 'explore_%s_%s_%d' % (world, load, k))
     shutil.rmtree(out, ignore_errors=True)
     env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % PORT)
-    start = time.time()
-    log = open(os.path.join(HERE, 'out', 'explore_%d.log' % k), 'w')
-    proc = subprocess.Popen(['roslaunch', '-p', str(PORT), 'mbot_slam_navigation', 'explore.launch',
-                             'real_time_factor:=4.0', 'report_dir:=' + out, 'shutdown_when_done:=true'],
-                            env=env, stdout=log, stderr=subprocess.STDOUT)
+    busy = None
+    if load == 'busy':
+        busy = multiprocessing.Process(target=spin, args=(time.time() + 7200,), daemon=True)
+        busy.start()
     try:
-        proc.wait(timeout=1200)
-    except subprocess.TimeoutExpired:
-        proc.terminate()
-        proc.wait()
-    log.close()
-    path = os.path.join(out, 'report.json')
-    if not os.path.isfile(path):
-        print('run %d: no report after %.0f s (log: %s)' % (k, time.time() - start, log.name), flush=True)
+        with open(os.path.join(log_dir, 'explore_%s_%s_%d.log' % (world, load, k)), 'w') as log:
+            r = run(['-p', str(PORT), 'mbot_slam_navigation', 'explore.launch',
+                     'world_name:=' + os.path.join(PKG, 'worlds', WORLDS[world][0]), 'report_dir:=' + out,
+                     'max_duration:=%d' % int(3 * WORLDS[world][1])], wall_timeout=3600.0, env=env, stdout=log)
+    finally:
+        if busy is not None:
+            busy.terminate()
+    if r is None:
+        print('%s %s run %d: no report' % (world, load, k), flush=True)
         return None
-    with open(path) as f:
-        r = json.load(f)
-    print('run %d: complete after %.0f s simulated, %.0f s wall; coverage %.1f%%, walls %.1f%% within 0.1 m, '
-          '%d goals (%d failed), %d collisions' % (k, r['exploration_time_s'], r['wall_time_s'],
-                                                    100 * r['coverage_of_reachable_free'],
-                                                    100 * r['walls_within_tolerance'], r['goals_sent'],
-                                                    r['goals_failed'], r['collisions']), flush=True)
+    print('%s %s run %d: %s after %.0f s simulated (%.0f s wall); coverage %.1f%%, walls %.1f%%, %d collisions, '
+          'plateau %.0f s, %d given up' % (world, load, k, r['outcome'], r['exploration_time_s'], r['wall_time_s'],
+                                         100 * r.get('coverage_of_reachable_free', 0),
+                                         100 * r.get('walls_within_tolerance', 0), r['collisions'],
+                                         r.get('longest_plateau_s', 0), len(r.get('given_up', []))), flush=True)
     return r
 
 
+def emit(world, load, metric, values, unit, target='', fmt='%.3g'):
+    note = 'runs: ' + ', '.join(fmt % v for v in values)
+    print(json.dumps({'benchmark': 'explore %s %s' % (world, load), 'metric': metric,
+                      'value': statistics.median(values) if values else float('nan'), 'unit': unit,
+                      'target': target, 'note': note}), flush=True)
+
+
 def main():
-    os.makedirs(os.path.join(HERE, 'out'), exist_ok=True)
-    reports = [r for r in (one_run(k) for k in range(1, RUNS + 1)) if r]
-    if not reports:
-        sys.exit(1)
-    emit('time to completion (simulated)', [r['exploration_time_s'] for r in reports], 's', '<= 600', '%.0f')
-    emit('wall time to completion at 4x', [r['wall_time_s'] for r in reports], 's', '', '%.0f')
-    emit('reachable free space explored', [100 * r['coverage_of_reachable_free'] for r in reports], '%', '>= 97',
-         '%.1f')
-    emit('wall cells within 0.1 m of a true wall', [100 * r['walls_within_tolerance'] for r in reports], '%', '100',
-         '%.2f')
-    emit('largest wall-cell distance', [r['wall_distance_max_m'] for r in reports], 'm', '<= 0.1', '%.3f')
-    emit('distance driven', [r['distance_m'] for r in reports], 'm', '', '%.1f')
-    emit('goals sent', [r['goals_sent'] for r in reports], '', '', '%d')
-    emit('goals failed', [r['goals_failed'] for r in reports], '', '', '%d')
-    emit('collisions', [r['collisions'] for r in reports], '', '0', '%d')
-    if len(reports) < RUNS:
-        print('%d of %d runs gave no report' % (RUNS - len(reports), RUNS))
-        sys.exit(1)
+    worlds = os.environ.get('BENCH_EXPLORE_WORLDS', ','.join(WORLDS)).split(',')
+    loads = os.environ.get('BENCH_EXPLORE_LOADS', 'quiet,busy').split(',')
+    log_dir = os.path.join(HERE, 'out')
+    os.makedirs(log_dir, exist_ok=True)
+    failed = False
+    for world in worlds:
+        runs = int(os.environ.get('BENCH_EXPLORE_RUNS', '5' if world == 'home' else '2'))
+        for load in loads:
+            reports = [one_run(world, load, k, log_dir) for k in range(1, runs + 1)]
+            done = [r for r in reports if r]
+            complete = [r for r in done if r['outcome'] == 'complete']
+            failed |= len(complete) < runs
+            emit(world, load, 'runs complete', [len(complete)], 'of %d' % runs, '= all', '%d')
+            if not done:
+                continue
+            times = [r['exploration_time_s'] for r in done]
+            emit(world, load, 'exploration time (simulated), median', times, 's', '<= %.0f' % WORLDS[world][1], '%.0f')
+            emit(world, load, 'exploration time (simulated), worst', [max(times)], 's', '', '%.0f')
+            emit(world, load, 'wall time', [r['wall_time_s'] for r in done], 's', '', '%.0f')
+            emit(world, load, 'reachable free space explored', [100 * r.get('coverage_of_reachable_free', 0)
+                                                                 for r in done], '%', '>= 97', '%.1f')
+            emit(world, load, 'walls within 0.1 m', [100 * r.get('walls_within_tolerance', 0) for r in done], '%',
+                 '>= 99', '%.1f')
+            emit(world, load, 'collisions', [r['collisions'] for r in done], '', '0', '%d')
+            emit(world, load, 'longest plateau with frontiers left', [r.get('longest_plateau_s', 0) for r in done],
+                 's', '<= 60', '%.0f')
+    sys.exit(1 if failed else 0)
 
 
 if __name__ == '__main__':

@@ -11,6 +11,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
+from mbot_slam_navigation.home_rooms import room_coverage
 from mbot_slam_navigation.map_stats import free_at
 from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupancy_to_image, save_map
 from mbot_slam_navigation.nav.frontiers import Grid
@@ -114,13 +115,18 @@ def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 40
 
 def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
                  curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
-                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2) -> Dict:
-    """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures."""
+                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
+    """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
+    With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free."""
     os.makedirs(report_dir, exist_ok=True)
     figures = dict(figures)
     figures['explored_area_m2'] = round(known_area(m), 2)
     if world is not None:
         figures.update(ground_truth_figures(m, world, start, robot_radius))
+        if rooms:
+            truth, origin = rasterize(world, m.resolution)
+            figures['room_coverage'] = {k: round(v, 3) for k, v in
+                                        room_coverage(m, truth, origin, m.resolution, rooms=rooms).items()}
     save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))

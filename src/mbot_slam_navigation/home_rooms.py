@@ -1,8 +1,11 @@
 """The simulated home's rooms (worlds/mbot_sim_gazebo_navigation.world, the table in DESIGN.md) and
 how much of each a saved map has seen. World frame = the map frame of a SLAM run started at the
 spawn point (0, 0, 0); metres."""
+import os
 from dataclasses import dataclass
-from typing import Dict
+from typing import Dict, Sequence, Tuple
+
+import yaml
 
 import numpy as np
 
@@ -31,8 +34,29 @@ HOME_ROOMS = (
 )
 
 
+def rooms_file_of(world_path: str) -> str:
+    """worlds/<name>.world -> worlds/<name>.rooms.yaml (tools/generate_world.py writes both)."""
+    return os.path.splitext(world_path)[0] + '.rooms.yaml'
+
+
+def load_rooms(path: str) -> Tuple[Room, ...]:
+    """The rooms of a rooms file; ValueError naming the file and the entry that is wrong."""
+    with open(path) as f:
+        data = yaml.safe_load(f) or {}
+    rooms = []
+    for i, r in enumerate(data.get('rooms') or []):
+        try:
+            room = Room(str(r['name']), float(r['xmin']), float(r['xmax']), float(r['ymin']), float(r['ymax']))
+        except (KeyError, TypeError, ValueError) as e:
+            raise ValueError('%s: rooms[%d]: needs name, xmin, xmax, ymin, ymax (%s)' % (path, i, e)) from None
+        if not (room.xmin < room.xmax and room.ymin < room.ymax):
+            raise ValueError('%s: rooms[%d] "%s": xmin < xmax and ymin < ymax required' % (path, i, room.name))
+        rooms.append(room)
+    return tuple(rooms)
+
+
 def room_coverage(m: LoadedMap, truth: np.ndarray, truth_origin, truth_resolution: float,
-                  margin: float = 0.15) -> Dict[str, float]:
+                  margin: float = 0.15, rooms: Sequence[Room] = HOME_ROOMS) -> Dict[str, float]:
     """For each room, the share of its truly free floor (cells of `truth`, the world rasterized at
     `truth_resolution` with origin `truth_origin`, 0 = free, more than `margin` from its walls) that
     the map `m` marks free. A floor point the map does not cover counts as unseen."""
@@ -42,7 +66,7 @@ def room_coverage(m: LoadedMap, truth: np.ndarray, truth_origin, truth_resolutio
     gx, gy = np.meshgrid(xs, ys)
     seen_free = free_at(m.data, m.resolution, m.origin, gx, gy, SAVER_FREE)
     out = {}
-    for r in HOME_ROOMS:
+    for r in rooms:
         floor = ((truth == 0) & (gx > r.xmin + margin) & (gx < r.xmax - margin)
                  & (gy > r.ymin + margin) & (gy < r.ymax - margin))
         out[r.name] = float(seen_free[floor].mean()) if floor.any() else 0.0

@@ -48,6 +48,7 @@ from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
 
 from mbot_slam_navigation import explore_report
+from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
@@ -414,16 +415,24 @@ class Explore:
             'given_up': [g.as_dict() for g in self.given_up],
         }
         if self.report_dir and self.map is not None:
-            world = None
+            world, rooms = None, ()
             if self.world_name and os.path.isfile(self.world_name):
                 world = load_world(self.world_name)
+                rooms_file = rooms_file_of(self.world_name)
+                if os.path.isfile(rooms_file):
+                    try:
+                        rooms = load_rooms(rooms_file)
+                    except ValueError as e:
+                        rospy.logwarn('explore: no coverage per room: %s' % e)
             figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
-                                                  self.curve, figures, world, start[:2], self.robot_radius)
+                                                  self.curve, figures, world, start[:2], self.robot_radius, rooms)
             print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
                   % os.path.abspath(self.report_dir), flush=True)
         for k, v in figures.items():
-            if k != 'given_up':
+            if k not in ('given_up', 'room_coverage'):
                 print('  %-28s %s' % (k, v), flush=True)
+        for name, share in figures.get('room_coverage', {}).items():
+            print('  room %-23s %.1f%% of its floor mapped' % (name, 100 * share), flush=True)
         for g in figures['given_up']:
             print('  given up: (%.2f, %.2f), %.1f m: %s' % (g['x'], g['y'], g['size_m'], g['why']), flush=True)
         rospy.loginfo('explore: exploration ended (%s): %s', outcome, figures)

@@ -1,0 +1,71 @@
+"""The shipped and generated worlds (tools/generate_world.py): they load, their spawn point is free
+and the origin, their room tables are valid and reachable, and a seed gives one world."""
+import glob
+import os
+import subprocess
+import sys
+
+import pytest
+
+from mbot_slam_navigation.explore_report import reachable_free_space
+from mbot_slam_navigation.home_rooms import HOME_ROOMS, load_rooms, rooms_file_of
+from mbot_slam_navigation.sim.sdf_world import load_world
+
+PKG = os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..'))
+ROOM_FILES = sorted(glob.glob(os.path.join(PKG, 'worlds', '*.rooms.yaml')) +
+                    glob.glob(os.path.join(PKG, 'test', 'data', 'worlds', '*.rooms.yaml')))
+
+
+def test_the_home_and_the_generated_worlds_have_room_tables():
+    names = {os.path.basename(p).split('.')[0] for p in ROOM_FILES}
+    assert {'mbot_sim_gazebo_navigation', 'office', 'apartment', 'large', 'gap', 'boxed'} <= names
+
+
+def test_the_home_rooms_file_is_the_design_table():
+    assert load_rooms(rooms_file_of(os.path.join(PKG, 'worlds', 'mbot_sim_gazebo_navigation.world'))) == HOME_ROOMS
+
+
+@pytest.mark.parametrize('rooms_file', [p for p in ROOM_FILES if 'boxed' not in p], ids=os.path.basename)
+def test_spawn_is_free_and_every_room_is_reachable(rooms_file):
+    world = load_world(rooms_file.replace('.rooms.yaml', '.world'))
+    assert world.shapes
+    mask, origin = reachable_free_space(world, (0.0, 0.0), 0.2)   # raises if the spawn point is in a shape
+    res = 0.05
+    for room in load_rooms(rooms_file):
+        r0, r1 = int((room.ymin - origin[1]) / res), int((room.ymax - origin[1]) / res)
+        c0, c1 = int((room.xmin - origin[0]) / res), int((room.xmax - origin[0]) / res)
+        share = mask[max(r0, 0):r1, max(c0, 0):c1].mean()
+        if os.path.basename(rooms_file) == 'gap.rooms.yaml' and room.name == 'east room':
+            assert share < 0.02  # behind a gap narrower than the robot, on purpose
+        else:
+            assert share > 0.3, '%s: %s is %.0f%% reachable' % (rooms_file, room.name, 100 * share)
+
+
+def test_large_world_size_and_office_rooms():
+    large = load_rooms(os.path.join(PKG, 'worlds', 'large.rooms.yaml'))
+    xs = [r.xmin for r in large] + [r.xmax for r in large]
+    ys = [r.ymin for r in large] + [r.ymax for r in large]
+    assert max(xs) - min(xs) >= 30.0 and max(ys) - min(ys) >= 20.0
+    office = [r.name for r in load_rooms(os.path.join(PKG, 'worlds', 'office.rooms.yaml'))]
+    assert 'lobby' in office and 'corridor' in office
+    assert sum(n.startswith('north room') for n in office) >= 3 and sum(n.startswith('south room') for n in office) >= 3
+
+
+def test_a_seed_gives_one_world_and_another_seed_another(tmp_path):
+    tool = os.path.join(PKG, 'tools', 'generate_world.py')
+    for seed, out in ((1, 'a'), (1, 'b'), (2, 'c')):
+        subprocess.run([sys.executable, tool, 'office', '--seed', str(seed), '--out', str(tmp_path / out)], check=True)
+    a, b, c = ((tmp_path / d / 'office.world').read_text() for d in 'abc')
+    assert a == b and a != c
+    shipped = open(os.path.join(PKG, 'worlds', 'office.world')).read()
+    assert shipped == a  # the shipped office world is seed 1's
+
+
+def test_a_bad_rooms_file_names_the_file_and_the_entry(tmp_path):
+    bad = tmp_path / 'w.rooms.yaml'
+    bad.write_text('rooms:\n- {name: hall, xmin: 0, xmax: 1, ymin: 0}\n')
+    with pytest.raises(ValueError, match=r'w.rooms.yaml: rooms\[0\]'):
+        load_rooms(str(bad))
+    bad.write_text('rooms:\n- {name: hall, xmin: 2, xmax: 1, ymin: 0, ymax: 1}\n')
+    with pytest.raises(ValueError, match='"hall"'):
+        load_rooms(str(bad))
