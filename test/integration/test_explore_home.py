@@ -2,17 +2,14 @@
 """explore in the home (explore_home.test): completion within 10 simulated minutes, at least 97% of
 the reachable free space explored, the walls within 0.1 m of the world's, no collision; the report's
 files are kept beside the test results (artifacts/explore_report)."""
-import json
 import os
-import shutil
 import unittest
 
 import rospy
 import rostest
-from std_msgs.msg import Bool
 
 from mbot_slam_navigation.msg import Contact
-from rviz_screen import artifact_dir
+from explore_result import wait_for_report
 
 LIMIT_S = 600.0  # [s] simulated, exploration until completion is announced
 
@@ -21,14 +18,8 @@ class ExploreHomeTest(unittest.TestCase):
     def test_exploration_finishes_and_maps_the_home(self):
         contacts = []
         rospy.Subscriber('/gazebo/contacts', Contact, contacts.append)
-        msg = rospy.wait_for_message('/explore/complete', Bool, timeout=60.0)
-        while not msg.data:
-            msg = rospy.wait_for_message('/explore/complete', Bool, timeout=1200.0)
-        report_dir = rospy.get_param('/explore/report_dir')
-        with open(os.path.join(report_dir, 'report.json')) as f:
-            r = json.load(f)
-        shutil.copytree(report_dir, os.path.join(artifact_dir(), 'explore_report'), dirs_exist_ok=True)
-        rospy.loginfo('explore: %s', r)
+        r = wait_for_report('explore_report', first_timeout=60.0)
+        report_dir = r['report_dir']
         self.assertEqual(r['outcome'], 'complete')
         self.assertLessEqual(r['exploration_time_s'], LIMIT_S)
         self.assertGreaterEqual(r['coverage_of_reachable_free'], 0.97)

@@ -4,18 +4,15 @@
 Private parameters of this test node: outcome (expected), max_exploration_s (simulated, the latest
 the outcome may be decided), given_up_x_min (a frontier given up must lie east of this x [m], or
 '' for none required)."""
-import json
 import os
-import shutil
 import unittest
 
 import rospy
 import rostest
-from std_msgs.msg import Bool
 
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.srv import GetModelState
-from rviz_screen import artifact_dir
+from explore_result import wait_for_report
 
 
 class ExploreOutcomeTest(unittest.TestCase):
@@ -25,14 +22,8 @@ class ExploreOutcomeTest(unittest.TestCase):
         given_up_x_min = rospy.get_param('~given_up_x_min', '')
         contacts = []
         rospy.Subscriber('/gazebo/contacts', Contact, contacts.append)
-        msg = rospy.wait_for_message('/explore/complete', Bool, timeout=120.0)
-        while not msg.data:
-            msg = rospy.wait_for_message('/explore/complete', Bool, timeout=900.0)
-        report_dir = rospy.get_param('/explore/report_dir')
-        with open(os.path.join(report_dir, 'report.json')) as f:
-            r = json.load(f)
-        shutil.copytree(report_dir, os.path.join(artifact_dir(), 'explore_%s_report' % expected), dirs_exist_ok=True)
-        rospy.loginfo('explore report: %s', r)
+        r = wait_for_report('explore_%s_report' % expected, end_timeout=900.0)
+        report_dir = r['report_dir']
         self.assertEqual(r['outcome'], expected, r)
         self.assertLessEqual(r['exploration_time_s'], limit)
         self.assertEqual(r['collisions'], 0)

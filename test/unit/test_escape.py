@@ -25,6 +25,8 @@ def test_escape_drives_backwards_to_a_point_behind_and_forwards_to_one_ahead():
     assert cmd[0] > 0 and cmd[1] > 0                                  # ahead and to the left
     cmd, _ = escape_command((0.0, 0.0, 0.0), (-0.6, 0.1), np.zeros((0, 2)), 0.2, 0.1)
     assert cmd[0] < 0 and cmd[1] < 0                                  # backing towards the left turns right
+    cmd, _ = escape_command((0.0, 0.0, 0.0), (0.0, 0.6), np.zeros((0, 2)), 0.2, 0.1)
+    assert cmd == (0.0, 0.5)                                          # abeam: a disc turns in place first
     assert escape_command((1.0, 1.0, 2.0), (1.05, 1.0), np.zeros((0, 2)), 0.2, 0.1) == (None, 'arrived')
 
 
@@ -36,6 +38,11 @@ def test_escape_stops_for_what_the_laser_sees_on_the_side_it_moves_to():
     posts = np.array([[0.22, 0.0], [0.0, 0.23], [0.0, -0.23]])
     cmd, why = escape_command((0.0, 0.0, 0.0), (-0.6, 0.0), posts, 0.2, 0.1)
     assert cmd is not None and cmd[0] < 0
+    # wedged against a table behind-right (0.05 m from the robot's edge): it may drive away from it
+    # forwards, though the table lies within the clearance of where it stands
+    table = np.array([[-0.1 + 0.02 * i, -0.25] for i in range(-5, 6)])
+    cmd, why = escape_command((0.0, 0.0, 0.0), (0.6, 0.0), table, 0.2, 0.1)
+    assert cmd is not None and cmd[0] > 0, why
 
 
 def test_motion_watch_counts_standing_still():

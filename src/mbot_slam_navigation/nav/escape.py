@@ -23,13 +23,14 @@ def backtrack_target(path: Sequence[Tuple[float, float]], robot: Tuple[float, fl
 
 def escape_command(pose: Tuple[float, float, float], target: Tuple[float, float], points: np.ndarray,
                    radius: float, speed: float, arrive: float = 0.1, clearance: float = 0.02,
-                   lookahead: float = 0.1) -> Tuple[Optional[Tuple[float, float]], str]:
+                   lookahead: float = 0.1, turn_in_place: float = 0.6) -> Tuple[Optional[Tuple[float, float]], str]:
     """((v [m/s], w [rad/s]), '') to drive for target, or (None, 'arrived') / (None, why blocked).
 
-    The robot (a disc of `radius`) goes forwards if the target is ahead, else backwards, turning
-    towards it as it goes (never in place: turning in place is what the robot could not do). It is
-    blocked when a laser point lies within radius + clearance of where it would be after
-    `lookahead` metres, on the side it moves to."""
+    The robot is a disc of `radius` (the mbot): it turns in place, which never sweeps new space for a
+    disc, until forwards or backwards (whichever needs less turning) faces the target within
+    turn_in_place [rad], then drives, steering towards it. It is blocked when a laser point lies
+    within radius + clearance of where it would be after `lookahead` metres and nearer to that than
+    it is now: moving away from what is already close (the wall it was wedged against) is allowed."""
     dx, dy = target[0] - pose[0], target[1] - pose[1]
     if math.hypot(dx, dy) < arrive:
         return None, 'arrived'
@@ -38,11 +39,13 @@ def escape_command(pose: Tuple[float, float, float], target: Tuple[float, float]
     direction = 1.0 if tx >= 0 else -1.0
     error = math.atan2(ty * direction, tx * direction)  # heading error of the travel direction
     w = max(-0.5, min(0.5, 1.5 * error))  # turns the travel direction (backwards too) towards it
+    if abs(error) > turn_in_place:
+        return (0.0, 0.5 if error > 0 else -0.5), ''
     v = direction * speed * max(0.3, math.cos(error))
     pts = np.asarray(points, float).reshape(-1, 2)
     if len(pts):
-        ahead = pts[:, 0] * direction > 0
-        d = np.hypot(pts[:, 0] - direction * lookahead, pts[:, 1])
-        if np.any(ahead & (d < radius + clearance)):
+        d_now = np.hypot(pts[:, 0], pts[:, 1])
+        d_new = np.hypot(pts[:, 0] - direction * lookahead, pts[:, 1])
+        if np.any((d_new < radius + clearance) & (d_new < d_now - 1e-3)):
             return None, 'the laser sees an obstacle %s the robot' % ('in front of' if direction > 0 else 'behind')
     return (v, w), ''

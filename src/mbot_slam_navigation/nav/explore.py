@@ -326,26 +326,30 @@ class Explore:
 
     def escape(self, pose) -> bool:
         """Backs the robot out along its own recent path (it drove in, so that way was free),
-        driving by cmd_vel and checking the laser, not the costmap that has it boxed in. True if it
-        got escape_distance out."""
+        driving by cmd_vel and checking the laser, not the costmap that has it boxed in; tries points
+        of the path at escape_distance, 1.6 and 0.6 times it. True if it got to one of them."""
         self.move_base.cancel_goal()
-        target = backtrack_target(self.path, pose[:2], self.escape_distance)
-        if target is None:
+        targets = []
+        for k in (1.0, 1.6, 0.6):
+            t = backtrack_target(self.path, pose[:2], k * self.escape_distance)
+            if t is not None and t not in targets:
+                targets.append(t)
+        if not targets:
             rospy.logerr('explore: the robot at (%.2f, %.2f) cannot move and has no path of its own to back out along'
                          % pose[:2])
             return False
         rospy.logwarn('explore: the robot at (%.2f, %.2f) made no progress for %.0f s and move_base cannot move it; '
-                      'backing out along its own path to (%.2f, %.2f)' % (pose[0], pose[1], self.motion.still_for(
-                          self.elapsed()), target[0], target[1]))
-        ok, why = self.drive_to(target)
-        self.cmd_pub.publish(Twist())
-        if ok:
-            rospy.logwarn('explore: backed out to (%.2f, %.2f); exploring on' % target)
-            self.clear_costmaps()
-            self.motion.reset(self.elapsed(), target)
-        else:
-            rospy.logerr('explore: could not back out: %s' % why)
-        return ok
+                      'backing out along its own path' % (pose[0], pose[1], self.motion.still_for(self.elapsed())))
+        for target in targets:
+            ok, why = self.drive_to(target)
+            self.cmd_pub.publish(Twist())
+            if ok:
+                rospy.logwarn('explore: backed out to (%.2f, %.2f); exploring on' % target)
+                self.clear_costmaps()
+                self.motion.reset(self.elapsed(), target)
+                return True
+            rospy.logwarn('explore: could not back out to (%.2f, %.2f): %s' % (target[0], target[1], why))
+        return False
 
     def drive_to(self, target: Tuple[float, float]) -> Tuple[bool, str]:
         """Drives straight for `target` (map frame), forwards or backwards, whichever faces it."""
