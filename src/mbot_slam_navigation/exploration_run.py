@@ -13,7 +13,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import List, Optional
+from typing import Dict, List, Optional
 
 
 def report_dir_of(launch_args: List[str]) -> Optional[str]:
@@ -34,6 +34,30 @@ def stop(proc: subprocess.Popen, grace_s: float = 30.0) -> int:
         except subprocess.TimeoutExpired:
             continue
     return proc.wait()
+
+
+def node_cpu_seconds(launch_pid: int) -> Dict[str, float]:
+    """CPU seconds (user + system) used so far by each node that roslaunch `launch_pid` started,
+    by node name (its __name:= argument), read from /proc."""
+    tick = os.sysconf('SC_CLK_TCK')
+    out = {}
+    for entry in os.listdir('/proc'):
+        if not entry.isdigit():
+            continue
+        try:
+            with open('/proc/%s/stat' % entry) as f:
+                stat = f.read()
+            with open('/proc/%s/cmdline' % entry, 'rb') as f:
+                args = f.read().decode(errors='replace').split('\0')
+        except OSError:
+            continue
+        fields = stat[stat.rindex(')') + 2:].split()  # after "pid (comm) "
+        if int(fields[1]) != launch_pid:
+            continue
+        name = next((a.split(':=', 1)[1] for a in args if a.startswith('__name:=')), None)
+        if name:
+            out[name] = (int(fields[11]) + int(fields[12])) / tick
+    return out
 
 
 def summary(r: dict, report_dir: str) -> str:
@@ -70,7 +94,9 @@ def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Option
             time.sleep(1.0)
         time.sleep(1.0)  # the explorer's last lines
         with open(report) as f:
-            return json.load(f)
+            r = json.load(f)
+        r['node_cpu_s'] = node_cpu_seconds(proc.pid)  # the whole run, start-up and return included
+        return r
     finally:
         stop(proc)
 

@@ -83,7 +83,13 @@ def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
     n, labels = cv2.connectedComponents(frontier, connectivity=8)
-    groups = [np.argwhere(labels == k) for k in range(1, n)]
+    # one pass over the labelled cells, split by label (not one scan of the grid per group)
+    rows, cols = np.nonzero(labels)
+    lab = labels[rows, cols]
+    order = np.argsort(lab, kind='stable')
+    rows, cols, lab = rows[order], cols[order], lab[order]
+    splits = np.flatnonzero(np.diff(lab)) + 1
+    groups = [np.column_stack([r, c]) for r, c in zip(np.split(rows, splits), np.split(cols, splits)) if len(r)]
     return sorted(groups, key=len, reverse=True)
 
 
@@ -92,6 +98,10 @@ def passable(costmap: Grid, m: Grid, occupied_min: int = 65) -> np.ndarray:
     in the map (the costmap may count unknown space as free)."""
     cost = costmap.data.astype(np.int16)
     ok = (cost >= 0) & (cost < COST_INSCRIBED)
+    if (m.data.shape == cost.shape and m.resolution == costmap.resolution
+            and np.allclose(m.origin, costmap.origin, atol=1e-6 * m.resolution)):
+        v = m.data.astype(np.int16)  # the usual case: the global costmap is laid on the map
+        return ok & (v >= 0) & (v < occupied_min)
     rows, cols = np.indices(cost.shape)
     x, y = costmap.centre_of(rows, cols)
     mr, mc = m.cell_of(x, y)
@@ -154,19 +164,26 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             continue
         cr, cc = costmap.cell_of(x, y)
         inside = costmap.inside(cr, cc)
-        near = np.zeros(cost.shape, np.uint8)
-        near[cr[inside], cc[inside]] = 1
-        candidates = (cv2.dilate(near, disc) > 0) & goal_ok
+        # the cells within goal_reach of the frontier, in a window around it (not the whole grid)
+        half = k // 2
+        r0, c0 = max(int(cr.min()) - half, 0), max(int(cc.min()) - half, 0)
+        r1, c1 = min(int(cr.max()) + half + 1, cost.shape[0]), min(int(cc.max()) + half + 1, cost.shape[1])
+        candidates = np.zeros((max(r1 - r0, 0), max(c1 - c0, 0)), bool)
+        if inside.any() and candidates.size:
+            near = np.zeros(candidates.shape, np.uint8)
+            near[cr[inside] - r0, cc[inside] - c0] = 1
+            candidates = (cv2.dilate(near, disc) > 0) & goal_ok[r0:r1, c0:c1]
         if not candidates.any():
             if unreachable is not None:
                 unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
                                            'unreachable: no cell within %.1f m of it that the robot can reach clear '
                                            'of obstacles on the global costmap' % goal_reach))
             continue
-        d = np.where(candidates, dist, np.inf)
-        gr, gc = np.unravel_index(int(np.argmin(d)), d.shape)
+        d = np.where(candidates, dist[r0:r1, c0:c1], np.inf)
+        wr, wc = np.unravel_index(int(np.argmin(d)), d.shape)
+        gr, gc = wr + r0, wc + c0
         gx, gy = costmap.centre_of(gr, gc)
-        path_m = float(d[gr, gc]) * costmap.resolution
+        path_m = float(d[wr, wc]) * costmap.resolution
         out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
                             potential_scale * path_m - gain_scale * size))
     return sorted(out, key=lambda f: f.cost)
