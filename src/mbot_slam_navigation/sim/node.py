@@ -2,8 +2,8 @@
 
 Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
 'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
-min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.15 simulated s: the
-lag of the slowest node that auto aims below), step_size (0.01 s), pub_clock_frequency (100 Hz of
+min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.1 simulated s: the
+lag of the slowest node that auto aims below; defaults in sim/pacing.py), step_size (0.01 s), pub_clock_frequency (100 Hz of
 simulated time), paused (false), gui (false), odometry_slip_stddev (0.02, relative, for encoder
 odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace ("gazebo": where services and the contacts topic live).
 
@@ -34,6 +34,7 @@ from tf2_msgs.msg import TFMessage
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.nonblocking_publisher import nonblocking_publisher
+from mbot_slam_navigation.sim import pacing
 from mbot_slam_navigation.sim.pacing import PacingError, make_pacer
 from mbot_slam_navigation.sim.sdf_world import World, load_world
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
@@ -80,9 +81,9 @@ class RobotIO:
 class SimNode:
     def __init__(self):
         self.pacer = make_pacer(rospy.get_param('~real_time_factor', 1.0),
-                                min_rtf=float(rospy.get_param('~min_real_time_factor', 0.25)),
-                                max_rtf=float(rospy.get_param('~max_real_time_factor', 100.0)),
-                                max_lag=float(rospy.get_param('~max_lag', 0.15)))
+                                min_rtf=float(rospy.get_param('~min_real_time_factor', pacing.MIN_RTF)),
+                                max_rtf=float(rospy.get_param('~max_real_time_factor', pacing.MAX_RTF)),
+                                max_lag=float(rospy.get_param('~max_lag', pacing.MAX_LAG)))
         step = float(rospy.get_param('~step_size', 0.01))
         clock_hz = float(rospy.get_param('~pub_clock_frequency', 100.0))
         self.paused = bool(rospy.get_param('~paused', False))

@@ -18,6 +18,10 @@ from dataclasses import dataclass, field
 from typing import Dict, Optional, Tuple
 
 AUTO = 'auto'
+# The defaults of the simulator's parameters (declared here once; sim/node.py reads them by name).
+MIN_RTF = 0.25      # ~min_real_time_factor [sim s / wall s]
+MAX_RTF = 100.0     # ~max_real_time_factor
+MAX_LAG = 0.1       # ~max_lag [simulated s]: a third of move_base's usual transform_tolerance (0.3 s)
 
 
 class PacingError(ValueError):
@@ -35,9 +39,9 @@ class Pacer:
     """The real-time factor. `auto` False: `rtf` stays as given (inf = free-running)."""
     rtf: float = 1.0                 # [sim s / wall s] current target; inf = no pacing
     auto: bool = False
-    min_rtf: float = 0.25            # [sim s / wall s] auto never goes below
-    max_rtf: float = 100.0           # [sim s / wall s] auto never goes above (inf allowed)
-    max_lag: float = 0.15            # [simulated s] the worst node lag auto aims below
+    min_rtf: float = MIN_RTF         # [sim s / wall s] auto never goes below
+    max_rtf: float = MAX_RTF         # [sim s / wall s] auto never goes above (inf allowed)
+    max_lag: float = MAX_LAG         # [simulated s] the worst node lag auto aims below
     adjust_period: float = 0.25      # [wall s]
     increase: float = 1.1            # factor per adjust_period while every node keeps up
     forget_after: float = 2.0        # [wall s] a node silent this long no longer counts
@@ -86,7 +90,7 @@ class Pacer:
         return True
 
 
-def make_pacer(real_time_factor, min_rtf: float = 0.25, max_rtf: float = 100.0, max_lag: float = 0.15) -> Pacer:
+def make_pacer(real_time_factor, min_rtf: float = MIN_RTF, max_rtf: float = MAX_RTF, max_lag: float = MAX_LAG) -> Pacer:
     """The pacer for the simulator's ~real_time_factor: a number >= 0 (0: as fast as possible) or
     'auto' (start at 1x, within [min_rtf, max_rtf]). Raises PacingError naming the parameter."""
     if not (min_rtf > 0 and max_rtf >= min_rtf):
