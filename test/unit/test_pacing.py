@@ -87,3 +87,14 @@ def test_fixed_factor_is_kept_and_measured():
     assert p.rtf == 4.0
     assert p.achieved == pytest.approx(4.0, rel=0.01)
     assert p.worst == ('/move_base', 5.0)
+
+
+def test_free_running_stays_free_alone_and_turns_auto_when_a_node_falls_behind():
+    p = make_pacer(0)
+    run(p, 10.0, lambda rtf: None, rtf_reached=120.0)
+    assert math.isinf(p.rtf) and not p.auto and p.achieved == pytest.approx(120.0, rel=0.01)
+    run(p, 1.0, lambda rtf: 0.5, rtf_reached=120.0, wall0=10.0, sim0=1200.0)  # behind, but under 1 s
+    assert math.isinf(p.rtf) and not p.went_auto
+    run(p, 0.5, lambda rtf: 30.0, rtf_reached=120.0, wall0=11.0, sim0=1400.0)  # 30 s behind
+    assert p.went_auto and p.auto and math.isinf(p.max_rtf)
+    assert p.rtf < 120.0  # slowed from what it reached

@@ -2,10 +2,11 @@
 
 Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
 'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
-min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.1 simulated s: the
-lag of the slowest node that auto aims below; defaults in sim/pacing.py), step_size (0.01 s), pub_clock_frequency (100 Hz of
-simulated time), paused (false), gui (false), odometry_slip_stddev (0.02, relative, for encoder
-odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace ("gazebo": where services and the contacts topic live).
+min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.1 simulated s:
+the lag of the slowest node that auto aims below; defaults in sim/pacing.py), step_size (0.01 s),
+pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false), odometry_slip_stddev
+(0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace
+("gazebo": where services and the contacts topic live).
 
 Publishes /clock; per robot (in its namespace): the drive's odometry topic and odom -> base tf,
 each laser's LaserScan, base_pose_ground_truth (nav_msgs/Odometry in the world frame). Services
@@ -113,7 +114,6 @@ class SimNode:
         self.tf_pub = nonblocking_publisher('/tf', TFMessage)
         self.rtf_pub = rospy.Publisher('~real_time_factor', Float64, queue_size=1)
         self.pacer_lock = threading.Lock()
-        self.free_running_warned = False
         rospy.Subscriber('/sim_heartbeat', Header, self.on_heartbeat, queue_size=50)
         s = self.gz_ns + '/'
         rospy.Service(s + 'spawn_urdf_model', SpawnModel, self.on_spawn)
@@ -226,14 +226,11 @@ class SimNode:
             p = self.pacer
             if decided:
                 self.rtf_pub.publish(Float64(p.achieved))
-                if not p.auto and math.isinf(p.rtf) and p.worst[1] > 1.0 and not self.free_running_warned:
-                    # real_time_factor 0 runs the clock away from the stack: keep it as fast as the
-                    # stack goes instead, and say so.
-                    self.free_running_warned = True
+                if p.went_auto:
+                    p.went_auto = False
                     rospy.logwarn('gazebo_sim: real_time_factor 0 runs /clock %.1f s ahead of %s; running as fast as '
                                   'the nodes keep up instead, as real_time_factor:=auto does (auto also bounds it with '
                                   '~min_real_time_factor/~max_real_time_factor)' % (p.worst[1], p.worst[0]))
-                    p.auto, p.max_rtf = True, math.inf
                 if p.auto and wall - self.last_report >= 10.0:
                     self.last_report = wall
                     rospy.loginfo('gazebo_sim: running at %.1fx real time (auto%s)' % (

@@ -12,6 +12,10 @@ Every `adjust_period` wall seconds the worst lag over the period (among nodes he
 sets the factor: above `max_lag` it falls in proportion (at most halved), below half of it the
 factor rises by `increase` per period, up to `max_rtf`; with no heartbeat at all it rises to the
 maximum. A factor of inf means "as fast as the simulator goes" (no sleeping).
+
+Free-running (real_time_factor 0) stays free while nobody reports a lag; once a node is more than
+`free_lag_limit` behind, the pacer turns to auto with no upper bound (`went_auto` says when), so a
+stack started at 0 still works, as fast as it keeps up.
 """
 import math
 from dataclasses import dataclass, field
@@ -48,6 +52,8 @@ class Pacer:
     heard: Dict[str, _Heard] = field(default_factory=dict)
     achieved: float = 0.0            # [sim s / wall s] measured over the last adjust_period
     worst: Tuple[str, float] = ('', 0.0)  # the node with the worst lag in the last period, and its lag
+    free_lag_limit: float = 1.0      # [simulated s] a lag that turns free-running into auto
+    went_auto: bool = False          # set when free-running turned into auto
     _mark: Optional[Tuple[float, float]] = None  # (wall, sim) at the last adjustment
 
     def heartbeat(self, node: str, lag: float, wall: float) -> None:
@@ -77,6 +83,8 @@ class Pacer:
         self.worst = max(((n, h.lag) for n, h in live.items()), key=lambda t: t[1], default=('', 0.0))
         for h in live.values():
             h.lag = 0.0
+        if not self.auto and math.isinf(self.rtf) and self.worst[1] > self.free_lag_limit:
+            self.auto, self.max_rtf, self.went_auto = True, math.inf, True
         if not self.auto:
             return True
         lag = self.worst[1]
