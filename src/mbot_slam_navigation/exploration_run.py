@@ -80,6 +80,8 @@ def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Option
     if os.path.exists(report):
         os.remove(report)  # a report from an earlier run must not end this one at once
     proc = subprocess.Popen(['roslaunch'] + launch, env=env, stdout=stdout, stderr=subprocess.STDOUT if stdout else None)
+    # A SIGTERM to this process (a bench killed, a CI timeout) must not leave the launch running.
+    previous = signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     t0 = time.monotonic()
     try:
         while not os.path.exists(report):
@@ -99,6 +101,7 @@ def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Option
         return r
     finally:
         stop(proc)
+        signal.signal(signal.SIGTERM, previous)
 
 
 def main(argv=None) -> None:
