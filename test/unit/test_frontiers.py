@@ -221,3 +221,24 @@ def test_a_frontier_behind_a_gap_narrower_than_the_robot_is_reported_unreachable
     assert len(unreachable) == 1 and isinstance(unreachable[0], GivenUp)
     u = unreachable[0].as_dict()
     assert u['x'] == pytest.approx(6.0, abs=0.1) and 'unreachable' in u['why']
+
+
+def test_a_frontier_still_there_after_its_goal_was_reached_is_given_up_not_chased():
+    # unknown space behind a bathtub: the robot stood at the goal, the frontier is still there
+    s = ExploreState()
+    f = Frontier(np.array([[3.0 + 0.05 * i, 0.5] for i in range(20)]), 1.0, (3.2, 0.1), 5.0, 14.0)
+    s.choose(0.0, [f], (0.0, 0.0))
+    s.reached(80.0, arrived=True)
+    # next cycle: the same cells, a goal 0.7 m further along
+    again = Frontier(f.cells[2:], 0.9, (3.9, 0.1), 0.7, 1.2)
+    eligible, waiting, given_up = s.screen(81.0, [again])
+    assert eligible == [] and waiting == 0 and 'reached' in given_up[0].why
+    # a frontier nearby that is new (a doorway seen from there) is not held back
+    door = Frontier(np.array([[3.3, 1.0 + 0.05 * i] for i in range(20)]), 1.0, (3.3, 0.6), 0.5, 0.5)
+    assert s.screen(81.0, [door])[0] == [door]
+    # a frontier that vanished on the way gives nothing up
+    t = ExploreState()
+    t.choose(0.0, [f], (0.0, 0.0))
+    far = frontier_at(-5.0, -5.0)
+    assert t.choose(10.0, [far], (0.0, 0.0)) is far  # f's frontier is gone: visited, no cells kept
+    assert t.screen(11.0, [again])[0] == [again]

@@ -208,7 +208,7 @@ class Explore:
         gx, gy = self.state.goal.goal
         if self.move_base.get_state() == GoalStatus.SUCCEEDED:
             self.goals.append((gx, gy, True))
-            self.state.reached(now)
+            self.state.reached(now, arrived=True)
             return False
         self.goals.append((gx, gy, False))
         text = self.move_base.get_goal_status_text()

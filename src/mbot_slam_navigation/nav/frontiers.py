@@ -196,9 +196,10 @@ class Blacklisted:
     goals: List[Tuple[float, float]]  # [m] the goals sent there (map frame)
     until: float                      # [s] when it may be tried again
     tries: int                        # how many times a goal here failed
-    cells: Optional[np.ndarray] = None  # (N, 2) [m] the frontier's cells when its goals failed; None: reached
+    cells: Optional[np.ndarray] = None  # (N, 2) [m] the frontier's cells then (None: its frontier vanished)
     size_m: float = 0.0
     why: str = ''                     # the last failure's reason
+    reached: bool = False             # the robot got to the goal (not a failure)
 
 
 def _near_fraction(a: np.ndarray, b: np.ndarray, distance: float) -> float:
@@ -237,18 +238,20 @@ class ExploreState:
 
     def avoid_goals(self, now: float) -> List[Tuple[float, float]]:
         """Goals that failed and may not be sent now (rank_frontiers' avoid_goals)."""
-        return [g for b in self.blacklist if b.cells is not None and (b.until > now or b.tries >= self.max_tries)
-                for g in b.goals]
+        return [g for b in self.blacklist if b.cells is not None and not b.reached
+                and (b.until > now or b.tries >= self.max_tries) for g in b.goals]
 
     def waiting_for_blacklist(self, now: float) -> bool:
         """True while some place may still be tried again later."""
         return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
 
     def _same_place(self, b: Blacklisted, f: Frontier) -> bool:
-        if any(math.hypot(f.goal[0] - x, f.goal[1] - y) < self.blacklist_radius for x, y in b.goals):
-            return True
         if b.cells is None:
             return False
+        # A goal near a failed one is the same place; near a reached one it may see more: there
+        # only the same cells make the same frontier.
+        if not b.reached and any(math.hypot(f.goal[0] - x, f.goal[1] - y) < self.blacklist_radius for x, y in b.goals):
+            return True
         return (_near_fraction(f.cells, b.cells, 0.3) >= self.same_frontier_overlap or
                 _near_fraction(b.cells, f.cells, 0.3) >= self.same_frontier_overlap)
 
@@ -323,7 +326,7 @@ class ExploreState:
             return
         f = self.goal
         for b in self.blacklist:
-            if b.cells is not None and self._same_place(b, f):
+            if b.cells is not None and not b.reached and self._same_place(b, f):
                 b.tries += 1
                 b.until = now + self.blacklist_timeout
                 b.goals.append(f.goal)
@@ -334,11 +337,16 @@ class ExploreState:
             self.blacklist.append(Blacklisted([f.goal], now + self.blacklist_timeout, 1, f.cells.copy(), f.size_m, why))
         self.goal = None
 
-    def reached(self, now: float) -> None:
-        """The goal was reached: its place is not sent again (a frontier still there cannot be seen
-        from it, e.g. unknown space under furniture)."""
+    def reached(self, now: float, arrived: bool = False) -> None:
+        """The goal's place is not sent again: its frontier vanished on the way, or (arrived) the
+        robot got there. A frontier that is still mostly the same after the robot stood at it cannot
+        be seen from the floor (the gap behind a bathtub, under furniture): it is given up, not
+        chased goal after goal along its cells."""
         if self.goal is not None:
-            self.blacklist.append(Blacklisted([self.goal.goal], now, self.max_tries))
+            cells = self.goal.cells.copy() if arrived else None
+            self.blacklist.append(Blacklisted([self.goal.goal], now, self.max_tries, cells, self.goal.size_m,
+                                              'its goal was reached and it is still there: not visible from the floor'
+                                              if arrived else '', reached=True))
         self.goal = None
 
 

@@ -2,7 +2,7 @@
 
 Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
 'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
-min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.1 simulated s:
+min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.15 simulated s:
 the lag of the slowest node that auto aims below; defaults in sim/pacing.py), step_size (0.01 s),
 pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false), odometry_slip_stddev
 (0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace

@@ -25,7 +25,7 @@ AUTO = 'auto'
 # The defaults of the simulator's parameters (declared here once; sim/node.py reads them by name).
 MIN_RTF = 0.25      # ~min_real_time_factor [sim s / wall s]
 MAX_RTF = 100.0     # ~max_real_time_factor
-MAX_LAG = 0.1       # ~max_lag [simulated s]: a third of move_base's usual transform_tolerance (0.3 s)
+MAX_LAG = 0.15      # ~max_lag [simulated s]: half of move_base's usual transform_tolerance (0.3 s)
 
 
 class PacingError(ValueError):
