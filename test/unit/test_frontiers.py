@@ -236,6 +236,13 @@ def test_a_frontier_still_there_after_its_goal_was_reached_is_given_up_not_chase
     # a frontier nearby that is new (a doorway seen from there) is not held back
     door = Frontier(np.array([[3.3, 1.0 + 0.05 * i] for i in range(20)]), 1.0, (3.3, 0.6), 0.5, 0.5)
     assert s.screen(81.0, [door])[0] == [door]
+    # a long frontier (a hall beyond laser range) of which the robot reached one end is not given up
+    u = ExploreState()
+    arc = Frontier(np.array([[0.05 * i, 3.0] for i in range(300)]), 15.0, (0.3, 2.6), 3.0, -6.0)
+    u.choose(0.0, [arc], (0.0, 0.0))
+    u.reached(40.0, arrived=True)
+    rest = Frontier(arc.cells[40:], 13.0, (2.6, 2.6), 2.0, -7.0)
+    assert u.screen(41.0, [rest])[0] == [rest]
     # a frontier that vanished on the way gives nothing up
     t = ExploreState()
     t.choose(0.0, [f], (0.0, 0.0))

@@ -320,8 +320,17 @@ class Explore:
                 print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
                       'wall' % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
                                 self.goals_failed(), now, time.monotonic() - wall0), flush=True)
-            rospy.sleep(self.period)
+            self.wait_cycle()
         return None
+
+    def wait_cycle(self) -> None:
+        """Until the next planning cycle: 1/planner_frequency, or sooner when move_base finishes the
+        goal (the robot would otherwise stand at a reached goal for up to a whole period)."""
+        end = rospy.Time.now() + rospy.Duration(self.period)
+        while not rospy.is_shutdown() and rospy.Time.now() < end:
+            if self.state.goal is not None and self.move_base.simple_state == SimpleGoalState.DONE:
+                return
+            rospy.sleep(min(0.25, self.period))
 
     def elapsed(self) -> float:
         """[s] simulated (ROS) time since the exploration started."""

@@ -337,13 +337,18 @@ class ExploreState:
             self.blacklist.append(Blacklisted([f.goal], now + self.blacklist_timeout, 1, f.cells.copy(), f.size_m, why))
         self.goal = None
 
-    def reached(self, now: float, arrived: bool = False) -> None:
+    def reached(self, now: float, arrived: bool = False, seen_radius: float = 1.5) -> None:
         """The goal's place is not sent again: its frontier vanished on the way, or (arrived) the
-        robot got there. A frontier that is still mostly the same after the robot stood at it cannot
-        be seen from the floor (the gap behind a bathtub, under furniture): it is given up, not
-        chased goal after goal along its cells."""
+        robot got there. Frontier cells within seen_radius [m] of a goal the robot stood at, and
+        still there, cannot be seen from the floor (the gap behind a bathtub, under furniture): a
+        frontier made mostly of those is given up, not chased goal after goal along its cells. A
+        long frontier of which the robot saw one end (a hall beyond laser range) is not."""
         if self.goal is not None:
-            cells = self.goal.cells.copy() if arrived else None
+            cells = None
+            if arrived:
+                c = self.goal.cells
+                near = np.hypot(c[:, 0] - self.goal.goal[0], c[:, 1] - self.goal.goal[1]) <= seen_radius
+                cells = c[near].copy() if near.any() else None
             self.blacklist.append(Blacklisted([self.goal.goal], now, self.max_tries, cells, self.goal.size_m,
                                               'its goal was reached and it is still there: not visible from the floor'
                                               if arrived else '', reached=True))
