@@ -258,6 +258,8 @@ class Explore:
                 rospy.sleep(self.period)
                 continue
             self.motion.update(now, pose[:2])
+            if self.motion.still_for(now) == 0.0:
+                escapes_failed = 0  # it moved: an earlier failed escape says nothing about here
             failed = self.finish_goal(now)
             goal = self.state.goal
             if self.state.stuck(now, pose[:2]):
