@@ -106,6 +106,7 @@ class Explore:
         r.report_unknown()
 
         self.map: Optional[Grid] = None
+        self.map_with_stamp: Tuple[Optional[Grid], rospy.Time] = (None, rospy.Time(0))
         self.costmap: Optional[Grid] = None
         self.collisions = 0
         self.start_time: Optional[rospy.Time] = None  # set when exploring starts
@@ -132,6 +133,7 @@ class Explore:
 
     def on_map(self, msg: OccupancyGrid) -> None:
         self.map = grid_of(msg)
+        self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
 
@@ -279,11 +281,12 @@ class Explore:
                 continue
             stats = {}
             unreachable: List[GivenUp] = []
-            ranked = rank_frontiers(self.map, self.costmap, pose[:2], self.min_frontier_size, self.potential_scale,
+            m, m_stamp = self.map_with_stamp
+            ranked = rank_frontiers(m, self.costmap, pose[:2], self.min_frontier_size, self.potential_scale,
                                     self.gain_scale, self.state.avoid(now), self.state.blacklist_radius,
                                     min_unknown_area=self.min_unknown_area, stats=stats,
                                     avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
-            frontiers, waiting, given_up = self.state.screen(now, ranked)
+            frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
             self.given_up = given_up + unreachable
             self.publish_markers(frontiers)
             self.plateau.update(now, explore_report.known_area(self.map), bool(frontiers) or self.state.goal is not None)

@@ -255,21 +255,26 @@ class ExploreState:
         return (_near_fraction(f.cells, b.cells, 0.3) >= self.same_frontier_overlap or
                 _near_fraction(b.cells, f.cells, 0.3) >= self.same_frontier_overlap)
 
-    def screen(self, now: float, frontiers: List[Frontier]) -> Tuple[List[Frontier], int, List[GivenUp]]:
-        """(frontiers that may be sent now, how many wait for their blacklist to expire, those given
-        up for good) by the failures recorded: a frontier that is the place of a failed goal (its
-        goal near that goal, or most of its cells near the failed frontier's cells, however it has
-        grown or shrunk since) waits blacklist_timeout, and is given up after max_tries failures."""
+    def screen(self, now: float, frontiers: List[Frontier],
+               map_time: float = math.inf) -> Tuple[List[Frontier], int, List[GivenUp]]:
+        """(frontiers that may be sent now, how many wait, those given up for good) by the failures
+        recorded: a frontier that is the place of a failed goal (its goal near that goal, or most of
+        its cells near the failed frontier's cells, however it has grown or shrunk since) waits
+        blacklist_timeout, and is given up after max_tries failures. A frontier still there at a
+        goal reached is given up only on a map made after the robot got there (map_time [s], the
+        stamp of the map the frontiers come from); until then it waits."""
         eligible, waiting, given_up = [], 0, []
         failures = [b for b in self.blacklist if b.cells is not None]
         for f in frontiers:
             matches = [b for b in failures if self._same_place(b, f)]
-            exhausted = [b for b in matches if b.tries >= self.max_tries]
+            unsettled = [b for b in matches if b.reached and map_time <= b.until]
+            exhausted = [b for b in matches if b.tries >= self.max_tries and b not in unsettled]
             if exhausted:
                 x, y = f.cells.mean(axis=0)
-                given_up.append(GivenUp(float(x), float(y), f.size_m, '%d goals failed (last: %s)'
-                                        % (exhausted[0].tries, exhausted[0].why)))
-            elif any(b.until > now for b in matches):
+                b = exhausted[0]
+                given_up.append(GivenUp(float(x), float(y), f.size_m, b.why if b.reached else
+                                        '%d goals failed (last: %s)' % (b.tries, b.why)))
+            elif unsettled or any(b.until > now and not b.reached for b in matches):
                 waiting += 1
             else:
                 eligible.append(f)
