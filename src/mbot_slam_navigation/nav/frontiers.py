@@ -234,7 +234,7 @@ class ExploreState:
 
     def avoid(self, now: float) -> List[Tuple[float, float]]:
         """Places whose frontier cells do not count now (rank_frontiers' avoid)."""
-        return [g for b in self.blacklist if b.until > now or b.tries >= self.max_tries for g in b.goals]
+        return [g for b in self.blacklist if b.reached or b.until > now or b.tries >= self.max_tries for g in b.goals]
 
     def avoid_goals(self, now: float) -> List[Tuple[float, float]]:
         """Goals that failed and may not be sent now (rank_frontiers' avoid_goals)."""
@@ -346,7 +346,8 @@ class ExploreState:
         """The goal's place is not sent again: its frontier vanished on the way, or (arrived) the
         robot got there. Frontier cells within seen_radius [m] of a goal the robot stood at, and
         still there, cannot be seen from the floor (the gap behind a bathtub, under furniture): a
-        frontier made mostly of those is given up, not chased goal after goal along its cells. A
+        frontier made mostly of those, reached max_tries times, is given up, not chased goal after
+        goal along its cells (once is not enough: at a doorway a step more may show the room). A
         long frontier of which the robot saw one end (a hall beyond laser range) is not."""
         if self.goal is not None:
             cells = None
@@ -354,9 +355,18 @@ class ExploreState:
                 c = self.goal.cells
                 near = np.hypot(c[:, 0] - self.goal.goal[0], c[:, 1] - self.goal.goal[1]) <= seen_radius
                 cells = c[near].copy() if near.any() else None
-            self.blacklist.append(Blacklisted([self.goal.goal], now, self.max_tries, cells, self.goal.size_m,
-                                              'its goal was reached and it is still there: not visible from the floor'
-                                              if arrived else '', reached=True))
+            for b in self.blacklist:
+                if cells is not None and b.reached and self._same_place(b, self.goal):
+                    b.tries += 1
+                    b.until = now
+                    b.goals.append(self.goal.goal)
+                    b.cells = np.concatenate([b.cells, cells])
+                    break
+            else:
+                self.blacklist.append(Blacklisted([self.goal.goal], now, 1 if cells is not None else self.max_tries,
+                                                  cells, self.goal.size_m, 'reached %d times and still there: not '
+                                                  'visible from the floor' % self.max_tries if arrived else '',
+                                                  reached=True))
         self.goal = None
 
 
