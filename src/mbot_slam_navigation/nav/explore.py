@@ -27,8 +27,7 @@ of furniture, makes no frontier), return_to_start (true), report_dir (''), world
 /gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
 progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
 scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
-escape_speed (0.1 m/s), escape_timeout (30 s), goal_reached_distance (0.3 m: a goal counts as
-reached this close, without move_base's final approach and turn; 0 waits for move_base).
+escape_speed (0.1 m/s), escape_timeout (30 s).
 """
 import math
 import os
@@ -102,7 +101,6 @@ class Explore:
         self.escape_distance = r.number('escape_distance', 0.6, positive=True)
         self.escape_speed = r.number('escape_speed', 0.1, positive=True)
         self.escape_timeout = r.number('escape_timeout', 30.0, positive=True)
-        self.goal_reached_distance = r.number('goal_reached_distance', 0.3, minimum=0.0)
         scan_topic = r.string('scan_topic', 'scan')
         cmd_vel_topic = r.string('cmd_vel_topic', 'cmd_vel')
         r.report_unknown()
@@ -205,20 +203,8 @@ class Explore:
             out.markers += [cells, goal]
         self.marker_pub.publish(out)
 
-    def close_to_goal(self, pose) -> bool:
-        """Near enough to the goal to see what its frontier hides (the laser sees all round): no
-        need to wait for move_base's final approach and turn to the goal's heading."""
-        g = self.state.goal
-        return g is not None and pose is not None and \
-            math.hypot(pose[0] - g.goal[0], pose[1] - g.goal[1]) <= self.goal_reached_distance
-
-    def finish_goal(self, now: float, pose=None) -> bool:
+    def finish_goal(self, now: float) -> bool:
         """Takes in move_base's result for the current goal, if it has one; True if it failed."""
-        if self.close_to_goal(pose) and self.move_base.simple_state != SimpleGoalState.DONE:
-            gx, gy = self.state.goal.goal
-            self.goals.append((gx, gy, True))
-            self.state.reached(now, arrived=True)  # the next goal preempts move_base's
-            return False
         if self.state.goal is None or self.move_base.simple_state != SimpleGoalState.DONE:
             return False
         gx, gy = self.state.goal.goal
@@ -276,7 +262,7 @@ class Explore:
             self.motion.update(now, pose[:2])
             if self.motion.still_for(now) == 0.0:
                 escapes_failed = 0  # it moved: an earlier failed escape says nothing about here
-            failed = self.finish_goal(now, pose)
+            failed = self.finish_goal(now)
             goal = self.state.goal
             if self.state.stuck(now, pose[:2]):
                 self.goals.append((goal.goal[0], goal.goal[1], False))
@@ -347,8 +333,7 @@ class Explore:
         goal (the robot would otherwise stand at a reached goal for up to a whole period)."""
         end = rospy.Time.now() + rospy.Duration(self.period)
         while not rospy.is_shutdown() and rospy.Time.now() < end:
-            if self.state.goal is not None and (self.move_base.simple_state == SimpleGoalState.DONE
-                                                or self.close_to_goal(self.robot_pose())):
+            if self.state.goal is not None and self.move_base.simple_state == SimpleGoalState.DONE:
                 return
             rospy.sleep(min(0.25, self.period))
 
