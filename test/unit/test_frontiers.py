@@ -255,3 +255,23 @@ def test_a_frontier_still_there_after_its_goal_was_reached_is_given_up_not_chase
     far = frontier_at(-5.0, -5.0)
     assert t.choose(10.0, [far], (0.0, 0.0)) is far  # f's frontier is gone: visited, no cells kept
     assert t.screen(11.0, [again])[0] == [again]
+
+
+def test_two_frontiers_pulling_the_robot_to_and_fro_end_after_max_goals_per_place():
+    # A is near and cheap but never gets explored (its goal is "reached" each time from afar and
+    # its cells move a little); B is far. Greedy choice alone would alternate forever (the office
+    # run that timed out after 208 goals).
+    s = ExploreState(max_goals_per_place=4, hysteresis=1.0)
+    a = lambda k: Frontier(np.array([[21.8 + 0.05 * i, 4.6 + 0.01 * k] for i in range(50)]), 2.5,
+                           (21.78, 4.33 + 0.05 * (k % 3)), 2.0, 3.5)
+    b = Frontier(np.array([[17.3, 3.7 + 0.05 * i] for i in range(200)]), 10.0, (17.28, 3.68), 12.0, 26.0)
+    sent_a = 0
+    for k in range(40):
+        eligible, _, given_up = s.screen(10.0 * k, [a(k), b])
+        g = s.choose(10.0 * k, eligible, (21.0, 4.0))
+        if g is not None and g.goal[0] > 20:
+            sent_a += 1
+            s.reached(10.0 * k + 5)  # its frontier vanished from under the goal and came back
+        if given_up:
+            break
+    assert sent_a == 4 and 'sent 4 times' in given_up[0].why

@@ -27,7 +27,8 @@ of furniture, makes no frontier), return_to_start (true), report_dir (''), world
 /gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
 progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
 scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
-escape_speed (0.1 m/s), escape_timeout (30 s).
+escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals sent within 0.6 m
+of one place before its frontier is given up; with the blacklist, this bounds every run).
 """
 import math
 import os
@@ -89,7 +90,8 @@ class Explore:
         self.state = ExploreState(progress_timeout=r.number('progress_timeout', 30.0, positive=True),
                                   blacklist_timeout=r.number('blacklist_timeout', 60.0, minimum=0.0),
                                   max_tries=r.integer('max_tries', 2, minimum=1),
-                                  hysteresis=r.number('hysteresis', 1.0, minimum=0.0))
+                                  hysteresis=r.number('hysteresis', 1.0, minimum=0.0),
+                                  max_goals_per_place=r.integer('max_goals_per_place', 5, minimum=1))
         self.return_to_start = r.boolean('return_to_start', True)
         self.report_dir = r.string('report_dir', '')
         self.world_name = r.string('world_name', '') or rospy.get_param('/gazebo/world_name', '')

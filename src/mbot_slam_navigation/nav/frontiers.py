@@ -226,11 +226,13 @@ class ExploreState:
     blacklist_radius: float = 0.6     # [m] around a failed or visited goal
     same_frontier_overlap: float = 0.5  # fraction of cells within 0.3 m that makes two frontiers one
     hysteresis: float = 1.0           # [cost] a new frontier must beat the current goal's by this
+    max_goals_per_place: int = 5      # new goals within blacklist_radius of one place before it is given up
     goal: Optional[Frontier] = None
     progress_at: Tuple[float, float] = (math.nan, math.nan)
     progress_time: float = 0.0
     blacklist: List[Blacklisted] = field(default_factory=list)
     goals_chosen: int = 0             # new goals (a goal that moved with its frontier is not new)
+    places: List[List[float]] = field(default_factory=list)  # [x, y, new goals sent there]
 
     def avoid(self, now: float) -> List[Tuple[float, float]]:
         """Places whose frontier cells do not count now (rank_frontiers' avoid)."""
@@ -244,6 +246,10 @@ class ExploreState:
     def waiting_for_blacklist(self, now: float) -> bool:
         """True while some place may still be tried again later."""
         return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
+
+    def _goals_sent_near(self, goal: Tuple[float, float]) -> int:
+        return sum(int(p[2]) for p in self.places
+                   if math.hypot(p[0] - goal[0], p[1] - goal[1]) < self.blacklist_radius)
 
     def _same_place(self, b: Blacklisted, f: Frontier) -> bool:
         if b.cells is None:
@@ -266,6 +272,13 @@ class ExploreState:
         eligible, waiting, given_up = [], 0, []
         failures = [b for b in self.blacklist if b.cells is not None]
         for f in frontiers:
+            sent = self._goals_sent_near(f.goal)
+            if sent >= self.max_goals_per_place:
+                # Chosen again and again and never explored (two frontiers pulling the robot to and
+                # fro): a bound on goals per place is what makes every exploration end.
+                x, y = f.cells.mean(axis=0)
+                given_up.append(GivenUp(float(x), float(y), f.size_m, 'sent %d times and never explored' % sent))
+                continue
             matches = [b for b in failures if self._same_place(b, f)]
             unsettled = [b for b in matches if b.reached and map_time <= b.until]
             exhausted = [b for b in matches if b.tries >= self.max_tries and b not in unsettled]
@@ -308,6 +321,12 @@ class ExploreState:
                 return current[0]
         self.goal = best
         self.goals_chosen += 1
+        for p in self.places:
+            if math.hypot(p[0] - best.goal[0], p[1] - best.goal[1]) < self.blacklist_radius:
+                p[2] += 1
+                break
+        else:
+            self.places.append([best.goal[0], best.goal[1], 1])
         self.progress_at, self.progress_time = robot, now
         return best
 
