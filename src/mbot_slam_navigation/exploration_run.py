@@ -61,6 +61,8 @@ def node_cpu_seconds(launch_pid: int) -> Dict[str, float]:
 
 
 def summary(r: dict, report_dir: str) -> str:
+    if 'why' in r:
+        return 'exploration: %s: %s; report in %s' % (r.get('outcome'), r['why'], report_dir)
     line = 'exploration: %s after %.0f s simulated (%.0f s wall)' % (r.get('outcome'), r.get('exploration_time_s', 0),
                                                                      r.get('wall_time_s', 0))
     if 'coverage_of_reachable_free' in r:

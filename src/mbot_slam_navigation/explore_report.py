@@ -130,8 +130,14 @@ def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goal
     save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
+    write_figures(report_dir, figures)
+    return figures
+
+
+def write_figures(report_dir: str, figures: Dict) -> None:
+    """report.json, written atomically (a reader never sees half a file)."""
+    os.makedirs(report_dir, exist_ok=True)
     tmp = os.path.join(report_dir, '.report.json.tmp')
     with open(tmp, 'w') as f:
         json.dump(figures, f, indent=2)
     os.replace(tmp, os.path.join(report_dir, 'report.json'))
-    return figures

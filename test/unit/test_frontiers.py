@@ -239,6 +239,11 @@ def test_a_frontier_still_there_after_its_goal_was_reached_is_given_up_not_chase
     assert s.screen(101.0, [again], map_time=99.0) == ([], 1, [])
     eligible, waiting, given_up = s.screen(103.0, [again], map_time=102.0)
     assert eligible == [] and waiting == 0 and 'reached 2 times' in given_up[0].why
+    # no newer map comes (SLAM publishes none while the robot stands still): it waits settle_time,
+    # no longer (a home run once waited for ever)
+    assert s.screen(105.0, [again], map_time=99.0)[1] == 1
+    eligible, waiting, given_up = s.screen(111.0, [again], map_time=99.0)
+    assert waiting == 0 and len(given_up) == 1
     # a frontier nearby that is new (a doorway seen from there) is not held back
     door = Frontier(np.array([[3.3, 1.0 + 0.05 * i] for i in range(20)]), 1.0, (3.3, 0.6), 0.5, 0.5)
     assert s.screen(81.0, [door])[0] == [door]

@@ -28,7 +28,9 @@ of furniture, makes no frontier), return_to_start (true), report_dir (''), world
 progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
 scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
 escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals sent within 0.6 m
-of one place before its frontier is given up; with the blacklist, this bounds every run).
+of one place before its frontier is given up; with the blacklist, this bounds every run),
+startup_timeout (300 s of wall time for move_base, the map, the costmap and the robot pose; then
+the report says not_started and why).
 """
 import math
 import os
@@ -99,6 +101,7 @@ class Explore:
         self.progress_period = r.number('progress_period', 10.0, positive=True)
         self.shutdown_when_done = r.boolean('shutdown_when_done', False)
         self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
+        self.startup_timeout = r.number('startup_timeout', 300.0, positive=True)
         self.return_timeout = r.number('return_timeout', 120.0, positive=True)
         self.escape_distance = r.number('escape_distance', 0.6, positive=True)
         self.escape_speed = r.number('escape_speed', 0.1, positive=True)
@@ -221,21 +224,32 @@ class Explore:
         self.state.fail(now, 'move_base: %s' % text)
         return True
 
+    def missing(self, start) -> str:
+        return ', '.join(what for what, missing in (
+            ('the move_base action server on %s' % rospy.resolve_name('move_base'),
+             not self.move_base.wait_for_server(rospy.Duration(0.01))),
+            ('a map on %s' % rospy.resolve_name(self.map_topic), self.map is None),
+            ('a costmap on %s' % rospy.resolve_name(self.costmap_topic), self.costmap is None),
+            ('the robot pose (%s -> %s)' % (self.global_frame, self.base_frame), start is None)) if missing)
+
     def run(self) -> None:
         rospy.loginfo('explore: waiting for move_base, the map and the global costmap...')
         waited = time.monotonic()
-        while not self.move_base.wait_for_server(rospy.Duration(5.0)) and not rospy.is_shutdown():
-            rospy.logwarn_throttle(30.0, 'explore: no move_base action server yet on %s (%.0f s)'
-                                   % (rospy.resolve_name('move_base'), time.monotonic() - waited))
         start = None
-        while not rospy.is_shutdown() and (self.map is None or self.costmap is None or start is None):
-            start = self.robot_pose()
-            rospy.sleep(0.5)
-            if time.monotonic() - waited > 20.0:
-                rospy.logwarn_throttle(30.0, 'explore: still waiting: %s' % ', '.join(
-                    what for what, missing in (('a map on %s' % self.map_topic, self.map is None),
-                                               ('a costmap on %s' % self.costmap_topic, self.costmap is None),
-                                               ('the robot pose', start is None)) if missing))
+        while not rospy.is_shutdown():
+            if self.move_base.wait_for_server(rospy.Duration(0.5)):
+                start = self.robot_pose()
+                if self.map is not None and self.costmap is not None and start is not None:
+                    break
+            elapsed = time.monotonic() - waited
+            if elapsed > self.startup_timeout:
+                why = 'nothing to explore with after %.0f s (wall): no %s' % (elapsed, self.missing(start))
+                rospy.logerr('explore: %s' % why)
+                self.write_failure(why)
+                return
+            if elapsed > 20.0:
+                rospy.logwarn_throttle(30.0, 'explore: still waiting (%.0f s) for %s' % (elapsed, self.missing(start)))
+            time.sleep(0.5)  # wall time: simulated time may not run yet
         if rospy.is_shutdown():
             return
         self.start_time = rospy.Time.now()
@@ -416,6 +430,13 @@ class Explore:
         x = t.transform.translation.x + r[ok] * np.cos(a[ok] + yaw)
         y = t.transform.translation.y + r[ok] * np.sin(a[ok] + yaw)
         return np.column_stack([x, y])
+
+    def write_failure(self, why: str) -> None:
+        """The report of a run that could not start (outcome not_started), so that whoever waits for
+        it (run_exploration, a test) learns why instead of waiting out its own limit."""
+        if self.report_dir:
+            explore_report.write_figures(os.path.abspath(self.report_dir), {'outcome': 'not_started', 'why': why})
+        self.done_pub.publish(Bool(True))
 
     def finish(self, outcome: str, start, wall0: float) -> None:
         t_explored = self.elapsed()

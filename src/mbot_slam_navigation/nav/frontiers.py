@@ -226,6 +226,7 @@ class ExploreState:
     blacklist_radius: float = 0.6     # [m] around a failed or visited goal
     same_frontier_overlap: float = 0.5  # fraction of cells within 0.3 m that makes two frontiers one
     hysteresis: float = 1.0           # [cost] a new frontier must beat the current goal's by this
+    settle_time: float = 10.0         # [s] at most to wait for a map made after a goal was reached
     max_goals_per_place: int = 5      # new goals within blacklist_radius of one place before it is given up
     goal: Optional[Frontier] = None
     progress_at: Tuple[float, float] = (math.nan, math.nan)
@@ -268,7 +269,7 @@ class ExploreState:
         its cells near the failed frontier's cells, however it has grown or shrunk since) waits
         blacklist_timeout, and is given up after max_tries failures. A frontier still there at a
         goal reached is given up only on a map made after the robot got there (map_time [s], the
-        stamp of the map the frontiers come from); until then it waits."""
+        stamp of the map the frontiers come from); until then it waits, settle_time at most."""
         eligible, waiting, given_up = [], 0, []
         failures = [b for b in self.blacklist if b.cells is not None]
         for f in frontiers:
@@ -280,7 +281,9 @@ class ExploreState:
                 given_up.append(GivenUp(float(x), float(y), f.size_m, 'sent %d times and never explored' % sent))
                 continue
             matches = [b for b in failures if self._same_place(b, f)]
-            unsettled = [b for b in matches if b.reached and map_time <= b.until]
+            # with no newer map within settle_time (SLAM publishes none while the robot stands
+            # still), it is judged on the map there is
+            unsettled = [b for b in matches if b.reached and map_time <= b.until and now - b.until < self.settle_time]
             exhausted = [b for b in matches if b.tries >= self.max_tries and b not in unsettled]
             if exhausted:
                 x, y = f.cells.mean(axis=0)
