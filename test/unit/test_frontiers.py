@@ -130,12 +130,13 @@ def test_failures_blacklist_expire_and_then_stick():
     a = frontier_at(1.0, 1.0)
     s.choose(0.0, [a], (0.0, 0.0))
     s.fail(10.0)
-    assert s.avoid(20.0) == [(1.0, 1.0)] and s.waiting_for_blacklist(20.0)
-    assert s.avoid(71.0) == [] and not s.waiting_for_blacklist(71.0)  # expired: may be tried again
+    assert s.avoid(20.0) == [(1.0, 1.0)] and s.screen(20.0, [a]) == ([], 1, [])
+    assert s.avoid(71.0) == [] and s.screen(71.0, [a]) == ([a], 0, [])  # expired: may be tried again
     s.choose(71.0, [a], (0.0, 0.0))
     s.fail(72.0)
     assert set(s.avoid(1000.0)) == {(1.0, 1.0)}                     # failed twice: for good
-    assert not s.waiting_for_blacklist(1000.0)
+    eligible, waiting, given_up = s.screen(1000.0, [a])
+    assert eligible == [] and waiting == 0 and '2 goals failed' in given_up[0].why
 
 
 def test_no_progress_gives_the_goal_up_and_reached_goals_are_not_sent_again():
@@ -148,7 +149,7 @@ def test_no_progress_gives_the_goal_up_and_reached_goals_are_not_sent_again():
     t = ExploreState()
     t.choose(0.0, [frontier_at(2.0, 2.0)], (0.0, 0.0))
     t.reached(10.0)
-    assert t.avoid(1e6) == [(2.0, 2.0)] and not t.waiting_for_blacklist(11.0)
+    assert t.avoid(1e6) == [(2.0, 2.0)]
 
 
 def test_unknown_space_inside_furniture_makes_no_frontier_when_asked():
@@ -207,7 +208,6 @@ def test_a_failed_goal_is_not_sent_again_whatever_goal_its_frontier_yields_next(
     eligible, waiting, given_up = s.screen(1e6, [grown])
     assert eligible == [] and waiting == 0 and len(given_up) == 1
     assert 'move_base: no valid plan' in given_up[0].why and given_up[0].size_m == pytest.approx(grown.size_m)
-    assert not s.waiting_for_blacklist(1e6)
 
 
 def test_a_frontier_behind_a_gap_narrower_than_the_robot_is_reported_unreachable():

@@ -244,10 +244,6 @@ class ExploreState:
         return [g for b in self.blacklist if b.cells is not None and not b.reached
                 and (b.until > now or b.tries >= self.max_tries) for g in b.goals]
 
-    def waiting_for_blacklist(self, now: float) -> bool:
-        """True while some place may still be tried again later."""
-        return any(b.until > now and b.tries < self.max_tries for b in self.blacklist)
-
     def _goals_sent_near(self, goal: Tuple[float, float]) -> int:
         return sum(int(p[2]) for p in self.places
                    if math.hypot(p[0] - goal[0], p[1] - goal[1]) < self.blacklist_radius)
