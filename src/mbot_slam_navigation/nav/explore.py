@@ -305,7 +305,7 @@ class Explore:
             frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
             self.given_up = given_up + unreachable
             self.publish_markers(frontiers)
-            self.plateau.update(now, explore_report.known_area(self.map), bool(frontiers) or self.state.goal is not None)
+            self.plateau.update(now, explore_report.known_area(m), bool(frontiers) or self.state.goal is not None)
             new = self.state.choose(now, frontiers, pose[:2])
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
