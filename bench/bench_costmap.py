@@ -5,11 +5,14 @@
   doors), the tutorial's inflation (inflation_radius 0.6 m, cost_scaling_factor 10, inscribed radius
   0.2 m). Median of 5, one core, through the binding (copying the 16 MB grid in and out: included).
   Target: under 100 ms.
-- Global plans (navfn-style Dijkstra and A*) on 1000 x 1000 and 4000 x 4000 inflated maps at 0.05 m
-  (the maze and an open floor), corner to corner and a 3 m path; median of 3, one core, binding
-  overhead included (the costmap and planner objects persist, as in a node). For scale, ROS's navfn here: 4000 x 4000 corner to corner about 650 ms, a 3 m
-  plan on it about 110 ms, 1000 x 1000 maze corner to corner about 38 ms. Targets: 4000 x 4000
-  corner to corner under 200 ms, a 3 m plan under 5 ms.
+- Global plans on 1000 x 1000 and 4000 x 4000 inflated maps at 0.05 m (the maze and an open
+  floor), corner to corner and a 3 m path; median of 3, binding overhead included (the costmap and
+  planner objects persist, as in a node). Three searches: the reference (the whole-map navfn-style
+  Dijkstra of before, use_bounds=False), the hierarchical Dijkstra (move_base's default) and A*.
+  Each prints its path length against the reference's and the highest cost it crosses (its closest
+  approach to a wall). Against navfn (peers.md), scaled by how the reference moved since the peers
+  were measured. Target: <= 0.3x navfn corner to corner; a 3 m plan under 5 ms. Run it on one core
+  (taskset -c 0), as the peers were.
 - Local planner cycle (TrajectoryPlannerROS.findBestPath) at the tutorial's settings
   (base_local_planner_params.yaml: 20 x 20 samples by the effective defaults, sim_time 1.7 s) on the
   tutorial's 5 m x 5 m rolling window at 0.05 m, the mbot's padded round footprint, an inflated
@@ -49,6 +52,25 @@ def median_ms(fn, runs):
     return 1000 * statistics.median(times), result
 
 
+# ROS 1 peers measured on these same inputs (../shared/data/peers.md), with our reference search of
+# that hour (the whole-map Dijkstra, now use_bounds=False): a peer figure is scaled by how that
+# reference moved, to compare on one machine state.
+PEER_PLANS = {  # (n, kind): (navfn ms, our reference Dijkstra ms in the peers' hour)
+    (4000, 'maze'): (876.0, 2431.0),
+    (4000, 'open'): (851.0, 2558.0),
+    (1000, 'maze'): (34.3, 92.6),
+}
+
+
+def path_length(path):
+    return float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
+
+
+def closest_cost(grid, path, resolution=0.05):
+    """The highest cost the path crosses: its closest approach to an obstacle (lower is clearer)."""
+    return max((int(grid[int(y / resolution), int(x / resolution)]) for x, y in path), default=0)
+
+
 def plans():
     for n in (1000, 4000):
         for kind in ('maze', 'open'):
@@ -63,16 +85,29 @@ def plans():
             cases = [('corner to corner', (2.5, 2.5), (size - 2.4, size - 2.4)),
                      ('3 m', (room + 1.2, room + 1.2), (room + 3.3, room + 3.3))]
             for label, start, goal in cases:
-                for astar in (False, True):
-                    planner = _core._GlobalPlanner(use_astar=astar)
-                    ms, (status, path, message, expanded) = median_ms(
-                        lambda: planner.make_plan(costmap, np.array(start), np.array(goal)), 3)
-                    name = 'A*' if astar else 'Dijkstra'
-                    target = ('< 200' if label == 'corner to corner' else '< 5') if n == 4000 else ''
+                results = {}
+                for name, astar, bounds in (('reference Dijkstra', False, False), ('Dijkstra', False, True),
+                                            ('A*', True, True)):
+                    planner = _core._GlobalPlanner(use_astar=astar, use_bounds=bounds)
+                    planner.make_plan(costmap, np.array(start), np.array(goal))  # buffers sized once, as in a node
+                    runs = 1 if not bounds and n == 4000 and label == 'corner to corner' else 3
+                    ms, (status, path, message, expanded, blocks) = median_ms(
+                        lambda: planner.make_plan(costmap, np.array(start), np.array(goal)), runs)
+                    results[name] = (ms, path)
+                    note = '%s, %d cells expanded, %d coarse blocks, path %.2f m, highest cost crossed %d' % (
+                        status, expanded, blocks, path_length(path), closest_cost(g, path))
+                    target = ''
+                    if name != 'reference Dijkstra':
+                        ref_ms, ref_path = results['reference Dijkstra']
+                        note += ', length %.3fx the reference\'s (highest cost %d)' % (
+                            path_length(path) / max(path_length(ref_path), 1e-9), closest_cost(g, ref_path))
+                        peer = PEER_PLANS.get((n, kind)) if label == 'corner to corner' else None
+                        if peer:
+                            navfn_now = peer[0] * ref_ms / peer[1]
+                            target = '<= 0.3x navfn'
+                            note += '; navfn %.0f ms scaled to this run %.0f ms: %.3fx navfn' % (peer[0], navfn_now, ms / navfn_now)
                     print(json.dumps(dict(benchmark='planner', metric='%s %dx%d %s %s' % (name, n, n, kind, label),
-                                          value=ms, unit='ms', target=target,
-                                          note='%s, %d cells expanded, %d poses' % (status, expanded, len(path)))),
-                          flush=True)
+                                          value=ms, unit='ms', target=target, note=note)), flush=True)
 
 
 def local_cycles():

@@ -567,14 +567,16 @@ PYBIND11_MODULE(_core, m) {
       });
   using mbot::core::GlobalPlanner;
   py::class_<GlobalPlanner>(m, "_GlobalPlanner")
-      .def(py::init([](bool use_astar, bool allow_unknown, double default_tolerance) {
+      .def(py::init([](bool use_astar, bool allow_unknown, double default_tolerance, bool use_bounds) {
              mbot::core::PlannerParams p;
              p.use_astar = use_astar;
              p.allow_unknown = allow_unknown;
              p.default_tolerance = default_tolerance;
+             p.use_bounds = use_bounds;
              return std::make_unique<GlobalPlanner>(p);
            }),
-           py::arg("use_astar") = false, py::arg("allow_unknown") = true, py::arg("default_tolerance") = 0.0)
+           py::arg("use_astar") = false, py::arg("allow_unknown") = true, py::arg("default_tolerance") = 0.0,
+           py::arg("use_bounds") = true)
       .def(
           "make_plan",
           [](GlobalPlanner& planner, const Costmap& map, const Eigen::Vector2d& start, const Eigen::Vector2d& goal) {
@@ -589,7 +591,8 @@ PYBIND11_MODULE(_core, m) {
               out(i, 0) = plan.path[i].x();
               out(i, 1) = plan.path[i].y();
             }
-            return py::make_tuple(std::string(mbot::core::toString(plan.status)), path, plan.message, plan.expanded);
+            return py::make_tuple(std::string(mbot::core::toString(plan.status)), path, plan.message, plan.expanded,
+                                  plan.coarse_blocks);
           },
           py::arg("costmap"), py::arg("start"), py::arg("goal"))
       .def(

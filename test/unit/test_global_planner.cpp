@@ -1,4 +1,6 @@
 #include <cmath>
+#include <algorithm>
+#include <cstdlib>
 
 #include <gtest/gtest.h>
 
@@ -116,3 +118,101 @@ TEST_P(BothPlanners, PrefersLowCostCells) {
 }
 
 INSTANTIATE_TEST_SUITE_P(DijkstraAndAStar, BothPlanners, ::testing::Values(false, true));
+
+namespace {
+// Rooms of `room` cells with one-cell walls and a `door`-cell door in each wall at a seeded place,
+// inflated as the costmap would be (lethal walls, a cost falling off over 6 cells).
+Costmap maze(int n, int room, int door, unsigned seed) {
+  Costmap m(n, n, 0.05, {0, 0});
+  std::srand(seed);
+  for (int k = 0; k < n; k += room) {
+    for (int j = 0; j < n; ++j) {
+      m.setCost({j, k}, cost::kLethal);
+      m.setCost({k, j}, cost::kLethal);
+    }
+    for (int j = 0; j + room <= n; j += room) {
+      const int a = j + 3 + std::rand() % (room - door - 6), b = j + 3 + std::rand() % (room - door - 6);
+      for (int d = 0; d < door; ++d) {
+        m.setCost({a + d, k}, cost::kFree);
+        m.setCost({k, b + d}, cost::kFree);
+      }
+    }
+  }
+  Costmap inflated = m;
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      if (m.cost({x, y}) != cost::kLethal) continue;
+      for (int dy = -6; dy <= 6; ++dy) {
+        for (int dx = -6; dx <= 6; ++dx) {
+          const Cell c{x + dx, y + dy};
+          if (!m.contains(c) || m.cost(c) == cost::kLethal) continue;
+          const double d = std::hypot(dx, dy);
+          const uint8_t v = d <= 2.0 ? cost::kInscribed : d <= 6.0 ? static_cast<uint8_t>(252 * std::exp(-0.5 * (d - 2))) : 0;
+          if (v > inflated.cost(c)) inflated.setCost(c, v);
+        }
+      }
+    }
+  }
+  return inflated;
+}
+}  // namespace
+
+// The hierarchical search (coarse blocks, then a corridor) against the whole-map search of before:
+// the same path length within 2% on random start / goal pairs in a maze, never through an obstacle.
+TEST_P(BothPlanners, HierarchicalPlansMatchTheWholeMapSearch) {
+  const Costmap m = maze(240, 40, 8, 7);
+  PlannerParams fast, reference;
+  fast.use_astar = reference.use_astar = GetParam();
+  reference.use_bounds = false;
+  GlobalPlanner a(fast), b(reference);
+  std::srand(11);
+  int compared = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Eigen::Vector2d s(0.05 * (std::rand() % 240), 0.05 * (std::rand() % 240));
+    const Eigen::Vector2d g(0.05 * (std::rand() % 240), 0.05 * (std::rand() % 240));
+    const Plan pa = a.makePlan(m, s, g), pb = b.makePlan(m, s, g);
+    ASSERT_EQ(pa.status, pb.status) << "trial " << trial << ": " << pa.message << " / " << pb.message;
+    if (pa.status != PlanStatus::kOk) continue;
+    ++compared;
+    EXPECT_FALSE(touchesObstacle(m, {pa.path.begin() + 1, pa.path.end()}))
+        << "trial " << trial << " from " << s.transpose() << " (cost " << int(m.cost(m.worldToCell(s))) << ") to " << g.transpose()
+        << "; the reference " << (touchesObstacle(m, {pb.path.begin() + 1, pb.path.end()}) ? "too" : "not");
+    EXPECT_LE(pathLength(pa.path), 1.02 * pathLength(pb.path) + 1e-9) << "trial " << trial << " from " << s.transpose() << " to " << g.transpose();
+  }
+  EXPECT_GE(compared, 20);
+}
+
+// A wall one cell thick inside blocks is invisible to the coarse level; the corridor then holds no
+// path and the search widens until it finds the way round.
+TEST_P(BothPlanners, ThinWallsTheCoarseLevelMissesAreStillAvoided) {
+  Costmap m(200, 60, 0.05, {0, 0});
+  for (int y = 0; y < 58; ++y) m.setCost({101, y}, cost::kLethal);  // a gap only at the top
+  PlannerParams p;
+  p.use_astar = GetParam();
+  GlobalPlanner planner(p);
+  const Plan plan = planner.makePlan(m, {1.0, 0.5}, {9.0, 0.5});
+  ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
+  EXPECT_FALSE(touchesObstacle(m, plan.path));
+  double top = 0.0;
+  for (const auto& q : plan.path) top = std::max(top, q.y());
+  EXPECT_GT(top, 58 * 0.05);
+}
+
+// A goal in a closed room: the coarse level proves there is no path without flooding the map.
+TEST_P(BothPlanners, NoPathIsFoundWithoutSearchingTheWholeMap) {
+  Costmap m(400, 400, 0.05, {0, 0});
+  for (int k = 300; k < 340; ++k) {
+    for (int t : {300, 339}) {
+      for (int d = -4; d <= 4; ++d) {  // walls 9 cells thick, as inflation makes them
+        m.setCost({k, t + d}, cost::kLethal);
+        m.setCost({t + d, k}, cost::kLethal);
+      }
+    }
+  }
+  PlannerParams p;
+  p.use_astar = GetParam();
+  GlobalPlanner planner(p);
+  const Plan plan = planner.makePlan(m, {1.0, 1.0}, {16.0, 16.0});
+  EXPECT_EQ(plan.status, PlanStatus::kNoPath);
+  EXPECT_EQ(plan.expanded, 0);
+}

@@ -9,6 +9,15 @@
 //   from the start, to the neighbour (8-connected) of lowest potential.
 // - A* (use_astar true): 8-connected search from the start with the euclidean distance times
 //   neutral_cost as heuristic (admissible: no cell costs less).
+// With use_bounds (the default), a plan is hierarchical: an A* over blocks of kBlock x kBlock cells
+// (a block costs the mean of its traversable cells; blocks with none are obstacles; neighbours are
+// connected where a fine step crosses their common edge, so any wall at least kBlock - 1 cells
+// thick is seen)
+// finds the way through the rooms and doors, then the fine search runs only in the corridor of
+// blocks within kCorridorRadius blocks of that way, ordered by a lower bound of what remains (the
+// octile distance). Should the corridor hold no path (a wall thinner than a block, that the coarse
+// level does not see), it is widened four times, then the whole map is searched: a path is found
+// whenever one exists. No coarse path proves there is no path, without flooding the map.
 // Failures are typed (Nav2's StartOccupied, GoalOccupied, NoValidPathCouldBeFound...), never an
 // empty path without a reason.
 #pragma once
@@ -35,6 +44,9 @@ struct PlannerParams {
   double default_tolerance = 0.0;  ///< [m] a blocked goal moves to the nearest free cell this close
   double neutral_cost = 50.0;
   double cost_factor = 0.8;
+  /// false: the searches of before (the whole wavefront / euclidean A*, a binary heap, no coarse
+  /// level), a reference for benchmarks and tests; the paths are the same up to ties.
+  bool use_bounds = true;
 };
 
 struct Plan {
@@ -43,6 +55,7 @@ struct Plan {
   Eigen::Vector2d goal = Eigen::Vector2d::Zero();  ///< the goal actually used (after tolerance)
   std::string message;                ///< why, for a failure
   int expanded = 0;                   ///< cells the search finalized
+  int coarse_blocks = 0;              ///< blocks the coarse search visited
 };
 
 class GlobalPlanner {
@@ -69,9 +82,28 @@ class GlobalPlanner {
     stamp_[i] = generation_;
     value_[i] = v;
   }
+  template <class Queue>
   bool search(const Costmap& map, int start, int goal, Plan& plan);
+  template <class Queue>
   bool searchAStar(const Costmap& map, int start, int goal, Plan& plan);
+  /// A* over the blocks from start's to goal's; fills coarse_path_. False: no path exists.
+  bool coarsePlan(int start, int goal, Plan& plan);
+  /// The mean cost of block (bx, by)'s traversable cells, +inf when it has none (cached per search).
+  float blockCost(int bx, int by);
+  /// Whether one fine step leads from block (bx, by) into its neighbour (bx + dx, by + dy): a pair
+  /// of facing boundary cells both traversable (for a diagonal neighbour, the corner step).
+  bool crossable(int bx, int by, int dx, int dy) const;
+  void markCorridor(int radius);
+  bool allowed(int x, int y) const {
+    return !corridor_active_ || corridor_[(y / kBlock) * bw_ + x / kBlock] == corridor_gen_;
+  }
+  void nextGeneration();
 
+ public:
+  static constexpr int kBlock = 4;            ///< [cells] side of a coarse block
+  static constexpr int kCorridorRadius = 3;   ///< [blocks] around the coarse way
+
+ private:
   PlannerParams params_;
   float cost_of_value_[256];
   float start_cost_ = 0.0f;
@@ -82,6 +114,17 @@ class GlobalPlanner {
   std::vector<uint8_t> done_;
   std::vector<int> parent_;
   uint32_t generation_ = 0;
+  // Coarse level (per block; valid where block_stamp_ == generation_).
+  int width_ = 0, height_ = 0, bw_ = 0, bh_ = 0;
+  std::vector<float> block_cost_, block_g_;
+  std::vector<uint32_t> block_stamp_;
+  std::vector<int> block_parent_;
+  std::vector<uint8_t> block_done_;
+  std::vector<int> coarse_path_;
+  int coarse_start_ = -1, coarse_goal_ = -1;
+  std::vector<uint32_t> corridor_;  // == corridor_gen_: the block is in the corridor
+  uint32_t corridor_gen_ = 0;
+  bool corridor_active_ = false;
 };
 
 }  // namespace core

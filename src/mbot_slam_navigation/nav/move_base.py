@@ -232,7 +232,7 @@ class MoveBase:
     def _plan(self, planner, start, goal) -> Tuple[bool, np.ndarray, str]:
         """Plans on the global costmap; (ok, N x 2 path ending at the goal, why not)."""
         costmap, _ = self.global_costmap.snapshot()
-        status, path, message, _ = planner.make_plan(costmap, np.array(start[:2], float), np.array(goal[:2], float))
+        status, path, message, _, _ = planner.make_plan(costmap, np.array(start[:2], float), np.array(goal[:2], float))
         if status != 'ok':
             return False, path, '%s: %s' % (status, message)
         if len(path) and math.hypot(path[-1][0] - goal[0], path[-1][1] - goal[1]) <= costmap.resolution:
