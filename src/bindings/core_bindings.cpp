@@ -529,6 +529,26 @@ PYBIND11_MODULE(_core, m) {
            })
       .def("move_origin", &Costmap::moveOrigin, py::arg("new_origin"), py::arg("fill"))
       .def(
+          "inflate",
+          [](Costmap& c, double inscribed_radius, double inflation_radius, double cost_scaling_factor, bool inflate_unknown) {
+            mbot::core::InflationParams p{inscribed_radius, inflation_radius, cost_scaling_factor, inflate_unknown};
+            py::gil_scoped_release release;
+            mbot::core::inflate(c, p);
+          },
+          "Inflates this costmap in place (no copies: as a node does).", py::arg("inscribed_radius"),
+          py::arg("inflation_radius"), py::arg("cost_scaling_factor"), py::arg("inflate_unknown") = false)
+      .def(
+          "inflate_window",
+          [](Costmap& c, const Costmap& base, int x0, int y0, int x1, int y1, double inscribed_radius,
+             double inflation_radius, double cost_scaling_factor, bool inflate_unknown) {
+            mbot::core::InflationParams p{inscribed_radius, inflation_radius, cost_scaling_factor, inflate_unknown};
+            py::gil_scoped_release release;
+            mbot::core::inflateWindow(base, c, {x0, y0, x1, y1}, p);
+          },
+          "Cells [x0, x1) x [y0, y1) become base's, inflated (bounded update).", py::arg("base"), py::arg("x0"),
+          py::arg("y0"), py::arg("x1"), py::arg("y1"), py::arg("inscribed_radius"), py::arg("inflation_radius"),
+          py::arg("cost_scaling_factor"), py::arg("inflate_unknown") = false)
+      .def(
           "update_with_scan",
           [](Costmap& c, const Eigen::Vector3d& sensor_pose, double angle_min, double angle_increment, double range_min,
              double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,

@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
-
-#include <opencv2/imgproc.hpp>
 
 namespace mbot {
 namespace core {
@@ -23,39 +22,182 @@ uint8_t inflatedCost(double d, const InflationParams& p) {
   return static_cast<uint8_t>((cost::kInscribed - 1) * std::exp(-p.cost_scaling_factor * (d - p.inscribed_radius)));
 }
 
-void inflate(Costmap& map, const InflationParams& params) {
+CellWindow CellWindow::unite(const CellWindow& o) const {
+  if (empty()) return o;
+  if (o.empty()) return *this;
+  return {std::min(x0, o.x0), std::min(y0, o.y0), std::max(x1, o.x1), std::max(y1, o.y1)};
+}
+
+CellWindow CellWindow::grown(int cells, int width, int height) const {
+  if (empty()) return *this;
+  return {std::max(0, x0 - cells), std::max(0, y0 - cells), std::min(width, x1 + cells), std::min(height, y1 + cells)};
+}
+
+namespace {
+
+// Inflation of `src`'s lethal cells into `dst` over `win`, reading `src` over `win` grown by the
+// radius. src and dst may be the same grid only when win covers it whole (the lethal cells are
+// read before any cell is raised, and raising never makes a cell lethal).
+void inflateInto(const Costmap& src, Costmap& dst, const CellWindow& win, const InflationParams& params) {
   params.validate();
-  const int w = map.width(), h = map.height();
-  std::vector<uint8_t>& costs = map.costs();
-  // distanceTransform measures to the nearest zero pixel: lethal cells are the zeros.
-  cv::Mat not_lethal(h, w, CV_8UC1);
-  bool any = false;
-  for (int i = 0; i < w * h; ++i) {
-    const bool lethal = costs[i] == cost::kLethal;
-    not_lethal.data[i] = lethal ? 0 : 255;
-    any = any || lethal;
-  }
-  if (!any) return;
-  cv::Mat dist;
-  cv::distanceTransform(not_lethal, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  // The exact transform measures integer offsets, so d^2 is an integer number of cells^2: a table
-  // indexed by it holds every cost there is (costmap_2d caches costs by cell distance likewise).
-  const double res = map.resolution();
-  const int max_cells = static_cast<int>(std::ceil(params.inflation_radius / res)) + 1;
-  std::vector<uint8_t> by_d2(max_cells * max_cells + 1);
+  if (win.empty()) return;
+  const int w = src.width(), h = src.height();
+  const double res = src.resolution();
+  // Cells farther than r (in cells) never take a cost; `cap` marks "no lethal cell within r".
+  const int r = static_cast<int>(std::floor(params.inflation_radius / res + 1e-9));
+  const int cap = r + 1;
+  if (cap > 65000) throw std::invalid_argument("inflation_radius is more than 65000 cells");
+  const CellWindow read = win.grown(r, w, h);
+  const int rw = read.x1 - read.x0;
+  // The cost for every squared distance [cells^2] that can occur within the radius.
+  std::vector<uint8_t> by_d2(static_cast<std::size_t>(r) * r + 1);
   for (std::size_t d2 = 0; d2 < by_d2.size(); ++d2) by_d2[d2] = inflatedCost(std::sqrt(double(d2)) * res, params);
-  const float* d = dist.ptr<float>(0);
-  for (int i = 0; i < w * h; ++i) {
-    const float cells = d[i];
-    if (cells == 0.0f || cells >= max_cells) continue;
-    const uint8_t c = by_d2[static_cast<std::size_t>(std::lround(cells * cells))];
-    uint8_t& old = costs[i];
-    if (old == cost::kNoInformation) {
-      if (params.inflate_unknown ? c > cost::kFree : c >= cost::kInscribed) old = c;
-    } else if (c > old) {
-      old = c;
+  const uint8_t* in = src.costs().data();
+  uint8_t* out = dst.costs().data();
+
+  // Column pass: for each cell of `read`'s columns and `win`'s rows, the vertical distance to the
+  // nearest lethal cell of its column within `read` (capped). Sweeps run row by row across all the
+  // columns at once, which the compiler vectorises.
+  const int rows = win.y1 - win.y0;
+  std::vector<uint16_t> g(static_cast<std::size_t>(rows) * rw, static_cast<uint16_t>(cap));
+  std::vector<uint16_t> run(rw, static_cast<uint16_t>(cap));
+  // Downward sweep from the top of `read`: distance to the nearest lethal cell above (or here).
+  for (int y = read.y0; y < win.y1; ++y) {
+    const uint8_t* row = in + static_cast<std::size_t>(y) * w + read.x0;
+    for (int i = 0; i < rw; ++i) {
+      const uint16_t up = static_cast<uint16_t>(std::min<int>(run[i] + 1, cap));
+      run[i] = row[i] == cost::kLethal ? 0 : up;
+    }
+    if (y >= win.y0) std::copy(run.begin(), run.end(), g.begin() + static_cast<std::size_t>(y - win.y0) * rw);
+  }
+  // Upward sweep from the bottom of `read`: the nearer of that and the lethal cells below.
+  std::fill(run.begin(), run.end(), static_cast<uint16_t>(cap));
+  for (int y = read.y1 - 1; y >= win.y0; --y) {
+    const uint8_t* row = in + static_cast<std::size_t>(y) * w + read.x0;
+    for (int i = 0; i < rw; ++i) {
+      const uint16_t down = static_cast<uint16_t>(std::min<int>(run[i] + 1, cap));
+      run[i] = row[i] == cost::kLethal ? 0 : down;
+    }
+    if (y < win.y1) {
+      uint16_t* gr = g.data() + static_cast<std::size_t>(y - win.y0) * rw;
+      for (int i = 0; i < rw; ++i) gr[i] = std::min(gr[i], run[i]);
     }
   }
+
+  // Row pass: d2(x) = min over |dx| <= r of dx^2 + g(x + dx)^2, only where some g is within r.
+  const int cap2 = cap * cap;
+  std::vector<uint32_t> g2(rw), d2(win.x1 - win.x0);
+  std::vector<int> near;
+  for (int y = win.y0; y < win.y1; ++y) {
+    const uint16_t* gr = g.data() + static_cast<std::size_t>(y - win.y0) * rw;
+    near.clear();
+    for (int i = 0; i < rw; ++i) {
+      g2[i] = static_cast<uint32_t>(gr[i]) * gr[i];
+      if (gr[i] < cap) near.push_back(i);
+    }
+    if (near.empty()) continue;  // no lethal cell within the radius: nothing to raise
+    std::fill(d2.begin(), d2.end(), static_cast<uint32_t>(cap2));
+    const int off = win.x0 - read.x0;  // d2[j] is for read column off + j
+    const int dw = win.x1 - win.x0;
+    if (near.size() * (2 * r + 1) < static_cast<std::size_t>(rw) * 4) {
+      // Few columns with an obstacle near: spread each over its neighbourhood.
+      for (int i : near) {
+        const int j0 = std::max(0, i - r - off), j1 = std::min(dw, i + r + 1 - off);
+        for (int j = j0; j < j1; ++j) {
+          const int dx = j + off - i;
+          d2[j] = std::min<uint32_t>(d2[j], static_cast<uint32_t>(dx * dx) + g2[i]);
+        }
+      }
+    } else {
+      // Obstacles near most columns: one vectorisable sweep per offset.
+      for (int dx = -r; dx <= r; ++dx) {
+        const uint32_t dd = static_cast<uint32_t>(dx * dx);
+        const int j0 = std::max(0, -dx - off), j1 = std::min(dw, rw - dx - off);
+        const uint32_t* src2 = g2.data() + off + dx;
+        for (int j = j0; j < j1; ++j) d2[j] = std::min<uint32_t>(d2[j], dd + src2[j]);
+      }
+    }
+    const uint8_t* base_row = in + static_cast<std::size_t>(y) * w + win.x0;
+    uint8_t* out_row = out + static_cast<std::size_t>(y) * w + win.x0;
+    for (int j = 0; j < dw; ++j) {
+      const uint8_t old = base_row[j];
+      if (d2[j] > static_cast<uint32_t>(r) * r) {
+        out_row[j] = old;
+        continue;
+      }
+      const uint8_t c = by_d2[d2[j]];
+      if (old == cost::kNoInformation) {
+        out_row[j] = (params.inflate_unknown ? c > cost::kFree : c >= cost::kInscribed) ? c : old;
+      } else {
+        out_row[j] = std::max(old, c);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void inflate(Costmap& map, const InflationParams& params) {
+  params.validate();
+  // Only tiles within the radius of a tile holding a lethal cell can change: find those first (one
+  // sequential read of the grid), then inflate tile row by tile row, each run of such tiles as one
+  // window. In place is safe: the passes read only which cells are lethal, and raising a cell never
+  // makes it lethal.
+  constexpr int kTile = 32;
+  const int w = map.width(), h = map.height();
+  const int r = static_cast<int>(std::floor(params.inflation_radius / map.resolution() + 1e-9));
+  const int tw = (w + kTile - 1) / kTile, th = (h + kTile - 1) / kTile;
+  std::vector<uint8_t> lethal(static_cast<std::size_t>(tw) * th, 0);
+  const uint8_t* c = map.costs().data();
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* row = c + static_cast<std::size_t>(y) * w;
+    uint8_t* flags = lethal.data() + static_cast<std::size_t>(y / kTile) * tw;
+    // memchr (glibc's is vectorised) finds the next lethal cell; the rest of its tile is skipped.
+    for (int x = 0; x < w;) {
+      const void* hit = std::memchr(row + x, cost::kLethal, static_cast<std::size_t>(w - x));
+      if (!hit) break;
+      const int t = static_cast<int>(static_cast<const uint8_t*>(hit) - row) / kTile;
+      flags[t] = 1;
+      x = (t + 1) * kTile;
+    }
+  }
+  const int reach = (r + kTile - 1) / kTile;  // tiles a lethal tile's inflation can reach
+  std::vector<uint8_t> active(lethal.size(), 0);
+  for (int ty = 0; ty < th; ++ty) {
+    for (int tx = 0; tx < tw; ++tx) {
+      if (!lethal[static_cast<std::size_t>(ty) * tw + tx]) continue;
+      for (int y = std::max(0, ty - reach); y <= std::min(th - 1, ty + reach); ++y) {
+        for (int x = std::max(0, tx - reach); x <= std::min(tw - 1, tx + reach); ++x) active[static_cast<std::size_t>(y) * tw + x] = 1;
+      }
+    }
+  }
+  for (int ty = 0; ty < th; ++ty) {
+    const uint8_t* flags = active.data() + static_cast<std::size_t>(ty) * tw;
+    for (int tx = 0; tx < tw;) {
+      if (!flags[tx]) {
+        ++tx;
+        continue;
+      }
+      int end = tx;
+      while (end < tw && flags[end]) ++end;
+      inflateInto(map, map, CellWindow{tx * kTile, ty * kTile, std::min(w, end * kTile), std::min(h, (ty + 1) * kTile)}, params);
+      tx = end;
+    }
+  }
+}
+
+void inflateWindow(const Costmap& base, Costmap& out, const CellWindow& window, const InflationParams& params) {
+  if (base.width() != out.width() || base.height() != out.height()) {
+    throw std::invalid_argument("inflateWindow: base and out must have the same size");
+  }
+  const CellWindow win = window.grown(0, base.width(), base.height());
+  if (win.empty()) return;
+  // Rows the pass skips keep base's values: copy them in first.
+  for (int y = win.y0; y < win.y1; ++y) {
+    const std::size_t i = static_cast<std::size_t>(y) * base.width();
+    std::copy(base.costs().begin() + i + win.x0, base.costs().begin() + i + win.x1, out.costs().begin() + i + win.x0);
+  }
+  inflateInto(base, out, win, params);
 }
 
 }  // namespace core

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -67,6 +69,83 @@ TEST(Inflation, UnknownCellsOnlyTakeInscribedCostsByDefault) {
   p.inflate_unknown = true;
   inflate(m, p);
   EXPECT_LT(m.cost({6, 0}), cost::kInscribed);
+}
+
+namespace {
+// Brute force: every cell's cost from its exact distance to every lethal cell.
+Costmap bruteInflation(const Costmap& m, const InflationParams& p) {
+  Costmap out = m;
+  for (int y = 0; y < m.height(); ++y) {
+    for (int x = 0; x < m.width(); ++x) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int v = 0; v < m.height(); ++v) {
+        for (int u = 0; u < m.width(); ++u) {
+          if (m.cost({u, v}) == cost::kLethal) best = std::min(best, std::hypot(u - x, v - y) * m.resolution());
+        }
+      }
+      if (!std::isfinite(best)) continue;
+      const uint8_t c = inflatedCost(best, p), old = m.cost({x, y});
+      if (old == cost::kNoInformation) {
+        if (p.inflate_unknown ? c > 0 : c >= cost::kInscribed) out.setCost({x, y}, c);
+      } else if (c > old) {
+        out.setCost({x, y}, c);
+      }
+    }
+  }
+  return out;
+}
+
+Costmap randomCostmap(int w, int h, unsigned seed, int lethal_per_mille) {
+  std::srand(seed);
+  Costmap m(w, h, 0.05, {0, 0});
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int r = std::rand() % 1000;
+      m.setCost({x, y}, r < lethal_per_mille ? cost::kLethal : r < 2 * lethal_per_mille ? cost::kNoInformation
+                                                                  : static_cast<uint8_t>(std::rand() % 60));
+    }
+  }
+  return m;
+}
+}  // namespace
+
+TEST(Inflation, MatchesBruteForceOnRandomGrids) {
+  InflationParams p;
+  p.inscribed_radius = 0.12;
+  p.inflation_radius = 0.4;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    p.inflate_unknown = seed % 2 == 0;
+    const Costmap m = randomCostmap(37, 29, seed, seed * 4);  // sparse to dense obstacles
+    Costmap fast = m;
+    inflate(fast, p);
+    EXPECT_EQ(fast.costs(), bruteInflation(m, p).costs()) << "seed " << seed;
+  }
+}
+
+TEST(Inflation, AWindowIsInflatedAsTheWholeMapAndNothingOutsideItChanges) {
+  InflationParams p;
+  p.inflation_radius = 0.3;
+  const Costmap base = randomCostmap(60, 50, 9, 8);
+  Costmap whole = base;
+  inflate(whole, p);
+  Costmap out(60, 50, 0.05, {0, 0}, 77);  // 77: a value neither layer produces here
+  const CellWindow win{10, 5, 31, 40};
+  inflateWindow(base, out, win, p);
+  for (int y = 0; y < 50; ++y) {
+    for (int x = 0; x < 60; ++x) {
+      const bool inside = x >= win.x0 && x < win.x1 && y >= win.y0 && y < win.y1;
+      ASSERT_EQ(out.cost({x, y}), inside ? whole.cost({x, y}) : 77) << x << ", " << y;
+    }
+  }
+  EXPECT_TRUE((CellWindow{0, 0, 0, 5}).empty());
+  const CellWindow u = CellWindow{2, 3, 4, 5}.unite({1, 4, 3, 9});
+  EXPECT_EQ(u.x0, 1);
+  EXPECT_EQ(u.y1, 9);
+  const CellWindow g = u.grown(3, 6, 20);
+  EXPECT_EQ(g.x0, 0);
+  EXPECT_EQ(g.x1, 6);
+  EXPECT_EQ(g.y0, 0);
+  EXPECT_EQ(g.y1, 12);
 }
 
 TEST(Footprint, RadiiPaddingAndCollision) {

@@ -1,8 +1,11 @@
 // costmap_2d's inflation layer: cost falls off with the distance d [m] from the nearest lethal cell:
 //   254 at d = 0, 253 while d <= inscribed_radius, then 252 * exp(-cost_scaling_factor *
 //   (d - inscribed_radius)) out to inflation_radius, 0 beyond.
-// Distances come from OpenCV's exact Euclidean distance transform over the whole window (one pass,
-// linear in the cells), not a per-obstacle wavefront.
+// Distances are exact Euclidean distances between cell centres, computed separably and only out to
+// the inflation radius: a column pass (the vertical distance to the nearest lethal cell, capped one
+// past the radius) then a row pass (the nearest of those over the columns within the radius). A row
+// with no lethal cell within the radius is skipped, so the work follows the obstacles (costmap_2d's
+// wavefront from its obstacle cells does the same), not the whole grid.
 #pragma once
 
 #include <cstdint>
@@ -23,9 +26,25 @@ struct InflationParams {
 /// The cost at distance d [m] from an obstacle.
 uint8_t inflatedCost(double distance_m, const InflationParams& params);
 
+/// A cell window [x0, x1) x [y0, y1) of a costmap (costmap_2d's update bounds, in cells).
+struct CellWindow {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  /// The smallest window holding both.
+  CellWindow unite(const CellWindow& o) const;
+  /// Grown by `cells` on every side, then clipped to a width x height grid.
+  CellWindow grown(int cells, int width, int height) const;
+};
+
 /// Inflates every lethal cell of `map` in place (cells keep the higher of their cost and the
 /// inflated one; unknown cells follow costmap_2d's inflate_unknown rule).
 void inflate(Costmap& map, const InflationParams& params);
+
+/// Bounded inflation: `out`'s cells inside `window` become `base`'s (the layers before inflation)
+/// raised by the inflation of `base`'s lethal cells, those outside the window included (the window
+/// is read with a margin of the radius). Cells outside the window are not touched. `base` and
+/// `out` must have the same size. Work is proportional to the window, not the map.
+void inflateWindow(const Costmap& base, Costmap& out, const CellWindow& window, const InflationParams& params);
 
 }  // namespace core
 }  // namespace mbot
