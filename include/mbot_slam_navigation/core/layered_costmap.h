@@ -1,0 +1,143 @@
+// costmap_2d's layered costmap, ROS-free: its configuration (read from a costmap namespace, both
+// styles) and the master grid composed from a static, an obstacle and an inflation layer.
+//
+// Configuration styles, as costmap_2d reads them:
+// - pre-Hydro (the tutorials): `static_map`, the obstacle keys (`observation_sources`,
+//   `obstacle_range`...) and the inflation keys at the top level of the costmap namespace;
+// - `plugins: [{name: ..., type: costmap_2d::StaticLayer}, ...]` with each layer's keys in
+//   `<costmap>/<name>/` (falling back to the top level, as ROS copies them there).
+//
+// Values are costmap_2d's (0 free, 1..252 inflated, 253 inscribed, 254 lethal, 255 unknown); the
+// grid's cell (0, 0) has its corner at `origin` [m] in the costmap's global_frame.
+//
+// Updates are bounded, as costmap_2d's updateBounds / updateCosts: each update recomposes and
+// re-inflates only the window that changed (the cells a scan's rays reached, the cells of a map
+// that differ from the last one, the footprint's old and new places), grown by the inflation
+// radius. A new map of another size, a moved rolling window or a reset redo the whole grid.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/footprint.h"
+#include "mbot_slam_navigation/core/inflation_layer.h"
+#include "mbot_slam_navigation/core/laser_scan.h"
+#include "mbot_slam_navigation/core/params.h"
+
+namespace mbot {
+namespace core {
+
+struct StaticLayerConfig {
+  std::string name = "static_layer";
+  std::string map_topic = "map";
+  bool first_map_only = false, subscribe_to_updates = false, track_unknown_space = true, use_maximum = false;
+  int lethal_cost_threshold = 100, unknown_cost_value = -1;
+  bool trinary_costmap = true, enabled = true;
+};
+
+struct ObservationSourceConfig {
+  std::string name, topic, sensor_frame;  ///< sensor_frame empty: each scan's header frame
+  double observation_persistence = 0.0, expected_update_rate = 0.0;  ///< [s]
+  bool clearing = false, marking = true;
+  double max_obstacle_height = 2.0, min_obstacle_height = 0.0;       ///< [m]
+  double obstacle_range = 2.5, raytrace_range = 3.0;                 ///< [m]
+  bool inf_is_valid = true;  ///< ROS's default is false (then +inf clears nothing); see the README
+};
+
+struct ObstacleLayerConfig {
+  std::string name = "obstacle_layer";
+  std::vector<ObservationSourceConfig> sources;
+  bool track_unknown_space = false, footprint_clearing_enabled = true, enabled = true;
+  int combination_method = 1;  ///< 0 overwrite, 1 maximum
+};
+
+struct InflationLayerConfig {
+  std::string name = "inflation_layer";
+  double inflation_radius = 0.55, cost_scaling_factor = 10.0;
+  bool inflate_unknown = false, enabled = true;
+};
+
+struct CostmapConfig {
+  std::string name;
+  std::string global_frame = "map", robot_base_frame = "base_link";
+  double transform_tolerance = 0.3, update_frequency = 5.0;
+  double publish_frequency = 1.0;  ///< ROS's default is 0 (never published); rviz users expect a costmap
+  bool rolling_window = false, always_send_full_costmap = false;
+  double width = 10.0, height = 10.0, resolution = 0.05, origin_x = 0.0, origin_y = 0.0;  ///< [m]
+  double footprint_padding = 0.01;
+  Footprint footprint;  ///< padded, robot frame [m]
+  double inscribed_radius = 0.0, circumscribed_radius = 0.0;
+  std::vector<std::pair<std::string, std::string>> layers;  ///< (name, kind: static, obstacle, inflation) in order
+  std::optional<StaticLayerConfig> static_layer;
+  std::optional<ObstacleLayerConfig> obstacle_layer;
+  std::optional<InflationLayerConfig> inflation_layer;
+};
+
+/// Reads the namespace `ns_prefix/name` (its values given), warning about misplaced and misspelt
+/// keys. Throws ParamError naming the key for values that cannot be used.
+CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& values, const Warn& warn,
+                                const std::string& ns_prefix = "");
+
+/// A footprint parameter: a list of [x, y] points, or the same written as a string.
+Footprint parseFootprint(const ParamValue& value, const std::string& where);
+
+/// costmap_2d's StaticLayer::interpretValue for one OccupancyGrid value.
+uint8_t staticCost(int8_t value, const StaticLayerConfig& params);
+
+class LayeredCostmap {
+ public:
+  LayeredCostmap(const CostmapConfig& config, Warn warn);
+  const CostmapConfig& config() const { return config_; }
+  /// False while a static layer waits for its first map.
+  bool ready() const { return !config_.static_layer || map_received_; }
+
+  /// A new map for the static layer (OccupancyGrid data, rows = y, origin of cell (0, 0) [m]).
+  void setMap(const std::vector<int8_t>& data, int width, int height, const Eigen::Vector2d& origin, double resolution);
+  /// Buffers one scan of source `source` (sensor pose in the global frame, height [m] above it).
+  /// False (warning once per source) when the sensor's height is outside the source's
+  /// [min_obstacle_height, max_obstacle_height]: costmap_2d drops every point of such a scan.
+  bool addScan(std::size_t source, double stamp, const Eigen::Vector3d& sensor_pose, double sensor_height,
+               const LaserScan& scan);
+  /// Sources whose expected_update_rate is overdue at `now` [s] (costmap_2d's isCurrent is false).
+  std::vector<std::string> staleSources(double now) const;
+  /// One update cycle at `robot_pose` (global frame); returns the window of cells that changed.
+  CellWindow update(const Eigen::Vector3d& robot_pose);
+  /// Clears the obstacle layer (clear_costmaps), or only outside a square of side `keep.z()`
+  /// centred on (keep.x(), keep.y()) (ClearCostmapRecovery's reset_distance).
+  void resetObstacles(const std::optional<Eigen::Vector3d>& keep = std::nullopt);
+
+  const Costmap& master() const { return master_; }
+  const Costmap& obstacles() const { return obstacle_; }
+  /// Index of the observation source named `name`, or -1.
+  int sourceIndex(const std::string& name) const;
+
+ private:
+  struct Observation {
+    double stamp;
+    Eigen::Vector3d pose;
+    LaserScan scan;
+  };
+  void resize(int width, int height, const Eigen::Vector2d& origin, double resolution);
+  void compose(const CellWindow& window);
+  CellWindow cellsAround(const Eigen::Vector2d& centre, double radius_m) const;
+
+  CostmapConfig config_;
+  Warn warn_;
+  InflationParams inflation_;
+  uint8_t obstacle_default_, default_value_;
+  Costmap static_, obstacle_, base_, master_;  // base_: the layers composed, before inflation
+  bool static_valid_ = false, map_received_ = false;
+  std::vector<std::vector<Observation>> observations_;
+  std::vector<bool> height_warned_;
+  CellWindow dirty_;        // cells whose layers changed since the last update
+  bool full_ = true;        // the whole grid must be recomposed
+  std::optional<Eigen::Vector3d> last_footprint_pose_;
+};
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,529 @@
+#include "mbot_slam_navigation/core/layered_costmap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "mbot_slam_navigation/core/local_planner.h"
+#include "mbot_slam_navigation/core/obstacle_layer.h"
+
+namespace mbot {
+namespace core {
+namespace {
+
+const std::map<std::string, std::string> kLayerTypes = {
+    {"costmap_2d::StaticLayer", "static"},
+    {"costmap_2d::ObstacleLayer", "obstacle"},
+    {"costmap_2d::VoxelLayer", "obstacle"},  // a 2D obstacle layer here: the simulated lasers are planar
+    {"costmap_2d::InflationLayer", "inflation"},
+};
+
+// Keys of move_base that tutorials put into costmap namespaces.
+const std::vector<std::string> kMoveBaseKeys = {
+    "controller_frequency", "planner_frequency", "controller_patience", "planner_patience", "oscillation_timeout",
+    "oscillation_distance", "max_planning_retries", "recovery_behaviors", "clearing_rotation_allowed",
+    "recovery_behavior_enabled", "shutdown_costmaps", "conservative_reset_dist", "base_global_planner",
+    "base_local_planner"};
+
+std::vector<std::string> keysOf(const std::map<std::string, std::string>& m) {
+  std::vector<std::string> out;
+  for (const auto& [k, _] : m) out.push_back(k);
+  return out;
+}
+
+// A layer's key, read from its own namespace or, when only set there, the costmap's top level.
+template <class F>
+auto fallback(ParamReader& layer, ParamReader& top, const std::string& key, F read) {
+  if (&layer != &top && !layer.has(key) && top.has(key)) return read(top);
+  return read(layer);
+}
+
+ObservationSourceConfig readSource(const std::string& name, const ParamValue& values, ParamReader& layer, const Warn& warn) {
+  ParamReader r(values, layer.ns() + "/" + name, warn);
+  ObservationSourceConfig s;
+  s.name = name;
+  s.topic = r.string("topic", name);
+  const ParamValue sf = r.raw("sensor_frame", ParamValue::ofString(""));
+  s.sensor_frame = sf.type == ParamValue::Type::kString && sf.s.empty() ? "" : r.frame("sensor_frame", "");
+  s.observation_persistence = r.number("observation_persistence", 0.0, 0.0);
+  s.expected_update_rate = r.number("expected_update_rate", 0.0, 0.0);
+  const std::string data_type = r.string("data_type", "PointCloud");
+  if (data_type != "LaserScan") {
+    throw ParamError("parameter " + r.where("data_type") + ": data_type \"" + data_type +
+                     "\" is not supported; only LaserScan sources are");
+  }
+  s.clearing = r.boolean("clearing", false);
+  s.marking = r.boolean("marking", true);
+  s.max_obstacle_height = r.number("max_obstacle_height", layer.number("max_obstacle_height", 2.0));
+  s.min_obstacle_height = r.number("min_obstacle_height", 0.0);
+  s.obstacle_range = r.number("obstacle_range", layer.number("obstacle_range", 2.5, std::nullopt, true), std::nullopt, true);
+  s.raytrace_range = r.number("raytrace_range", layer.number("raytrace_range", 3.0, std::nullopt, true), std::nullopt, true);
+  s.inf_is_valid = r.boolean("inf_is_valid", true);
+  r.reportUnknown();
+  return s;
+}
+
+}  // namespace
+
+Footprint parseFootprint(const ParamValue& value, const std::string& where) {
+  ParamValue v = value;
+  if (v.type == ParamValue::Type::kString) {
+    // "[[x, y], [x, y], ...]": numbers in brackets, pairwise.
+    std::vector<double> numbers;
+    std::string text = v.s;
+    int depth = 0, max_depth = 0;
+    for (char& c : text) {
+      if (c == '[') max_depth = std::max(max_depth, ++depth);
+      if (c == ']') --depth;
+      if (c == '[' || c == ']' || c == ',') c = ' ';
+    }
+    std::istringstream in(text);
+    double x;
+    while (in >> x) numbers.push_back(x);
+    if (!in.eof() || depth != 0 || max_depth != 2 || numbers.size() % 2 != 0 || numbers.empty()) {
+      throw ParamError("parameter " + where + ": cannot read \"" + value.s + "\" as a list of [x, y] points");
+    }
+    Footprint out;
+    for (std::size_t k = 0; k < numbers.size(); k += 2) out.emplace_back(numbers[k], numbers[k + 1]);
+    return out;
+  }
+  Footprint out;
+  bool ok = v.type == ParamValue::Type::kList;
+  for (const auto& p : v.items) {
+    if (p.type != ParamValue::Type::kList || p.items.size() != 2 || !p.items[0].isNumber() || !p.items[1].isNumber()) {
+      ok = false;
+      break;
+    }
+    out.emplace_back(p.items[0].number(), p.items[1].number());
+  }
+  if (!ok) throw ParamError("parameter " + where + ": expected a list of [x, y] points, got " + value.repr());
+  return out;
+}
+
+CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& values, const Warn& warn,
+                                const std::string& ns_prefix) {
+  CostmapConfig c;
+  c.name = name;
+  std::string prefix = ns_prefix;
+  while (!prefix.empty() && prefix.back() == '/') prefix.pop_back();
+  const std::string ns = prefix + "/" + name;
+  ParamReader r(values, ns, warn);
+  c.global_frame = r.frame("global_frame", "map");
+  c.robot_base_frame = r.frame("robot_base_frame", "base_link");
+  c.transform_tolerance = r.number("transform_tolerance", 0.3, 0.0);
+  c.update_frequency = r.number("update_frequency", 5.0, 0.0);
+  c.publish_frequency = r.number("publish_frequency", 1.0, 0.0);
+  c.rolling_window = r.boolean("rolling_window", false);
+  c.always_send_full_costmap = r.boolean("always_send_full_costmap", false);
+  c.width = r.number("width", 10.0, std::nullopt, true);
+  c.height = r.number("height", 10.0, std::nullopt, true);
+  c.resolution = r.number("resolution", 0.05, std::nullopt, true);
+  c.origin_x = r.number("origin_x", 0.0);
+  c.origin_y = r.number("origin_y", 0.0);
+  c.footprint_padding = r.number("footprint_padding", 0.01);
+  Footprint footprint;
+  const ParamValue* fp = r.values().get("footprint");
+  const bool fp_empty = !fp || fp->type == ParamValue::Type::kNone || (fp->type == ParamValue::Type::kList && fp->items.empty()) ||
+                        (fp->type == ParamValue::Type::kString && (fp->s == "[]" || fp->s.empty()));
+  if (!fp_empty) {
+    footprint = parseFootprint(r.raw("footprint"), r.where("footprint"));
+    if (r.has("robot_radius")) {
+      r.markRead("robot_radius");
+      warn(ns + ": both footprint and robot_radius are set; the footprint polygon is used");
+    }
+  } else {
+    r.markRead("footprint");
+    footprint = circleFootprint(r.number("robot_radius", 0.46, std::nullopt, true));
+  }
+  try {
+    validateFootprint(footprint);
+  } catch (const std::invalid_argument& e) {
+    throw ParamError("parameter " + r.where("footprint") + ": " + e.what());
+  }
+  c.footprint = padFootprint(footprint, c.footprint_padding);
+  c.inscribed_radius = inscribedRadius(c.footprint);
+  c.circumscribed_radius = circumscribedRadius(c.footprint);
+
+  // Layers: (name, kind, reader of the layer's keys; the top-level reader for the pre-Hydro style).
+  std::vector<std::tuple<std::string, std::string, std::unique_ptr<ParamReader>>> layers;
+  std::set<std::string> sub_namespaces;
+  if (r.has("plugins")) {
+    const ParamValue plugins = r.raw("plugins");
+    if (plugins.type != ParamValue::Type::kList) {
+      throw ParamError("parameter " + r.where("plugins") + " must be a list of {name, type}, got " + plugins.repr());
+    }
+    for (std::size_t i = 0; i < plugins.items.size(); ++i) {
+      const ParamValue& p = plugins.items[i];
+      const ParamValue* pname = p.get("name");
+      const ParamValue* ptype = p.get("type");
+      const std::string at = "parameter " + r.where("plugins") + "[" + std::to_string(i) + "]";
+      if (!pname || !ptype || pname->type != ParamValue::Type::kString || ptype->type != ParamValue::Type::kString) {
+        throw ParamError(at + " must have a name and a type, got " + p.repr());
+      }
+      const auto kind = kLayerTypes.find(ptype->s);
+      if (kind == kLayerTypes.end()) {
+        const std::string guess = nearestKey(ptype->s, keysOf(kLayerTypes));
+        std::string known;
+        for (const auto& [k, _] : kLayerTypes) known += (known.empty() ? "" : ", ") + k;
+        throw ParamError(at + ": unknown layer type \"" + ptype->s + "\"" + (guess.empty() ? "" : " (did you mean " + guess + "?)") +
+                         "; known: " + known);
+      }
+      const ParamValue* lv = r.values().get(pname->s);
+      sub_namespaces.insert(pname->s);
+      layers.emplace_back(pname->s, kind->second,
+                          std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
+                                                        ns + "/" + pname->s, warn));
+    }
+  } else {
+    // Pre-Hydro: the layers ROS builds from the old keys, which live at the top level.
+    if (r.boolean("static_map", true)) layers.emplace_back("static_layer", "static", nullptr);
+    const std::string map_type = r.string("map_type", "costmap");
+    if (map_type != "costmap" && map_type != "voxel") {
+      throw ParamError("parameter " + r.where("map_type") + " must be costmap or voxel, got \"" + map_type + "\"");
+    }
+    layers.emplace_back("obstacle_layer", "obstacle", nullptr);
+    layers.emplace_back("inflation_layer", "inflation", nullptr);
+  }
+  for (auto& [layer_name, kind, reader] : layers) {
+    ParamReader& lr = reader ? *reader : r;
+    c.layers.emplace_back(layer_name, kind);
+    std::set<std::string> skip;
+    if (kind == "static") {
+      StaticLayerConfig s;
+      s.name = layer_name;
+      s.map_topic = fallback(lr, r, "map_topic", [](ParamReader& p) { return p.string("map_topic", "map"); });
+      s.first_map_only = fallback(lr, r, "first_map_only", [](ParamReader& p) { return p.boolean("first_map_only", false); });
+      s.subscribe_to_updates =
+          fallback(lr, r, "subscribe_to_updates", [](ParamReader& p) { return p.boolean("subscribe_to_updates", false); });
+      s.track_unknown_space =
+          fallback(lr, r, "track_unknown_space", [](ParamReader& p) { return p.boolean("track_unknown_space", true); });
+      s.use_maximum = fallback(lr, r, "use_maximum", [](ParamReader& p) { return p.boolean("use_maximum", false); });
+      s.lethal_cost_threshold = static_cast<int>(
+          fallback(lr, r, "lethal_cost_threshold", [](ParamReader& p) { return p.integer("lethal_cost_threshold", 100, 0); }));
+      s.unknown_cost_value =
+          static_cast<int>(fallback(lr, r, "unknown_cost_value", [](ParamReader& p) { return p.integer("unknown_cost_value", -1); }));
+      s.trinary_costmap = fallback(lr, r, "trinary_costmap", [](ParamReader& p) { return p.boolean("trinary_costmap", true); });
+      s.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      c.static_layer = s;
+    } else if (kind == "obstacle") {
+      ObstacleLayerConfig o;
+      o.name = layer_name;
+      const std::string names =
+          fallback(lr, r, "observation_sources", [](ParamReader& p) { return p.string("observation_sources", ""); });
+      // The layer's range keys are the defaults of its sources.
+      for (const char* key : {"obstacle_range", "raytrace_range", "max_obstacle_height"}) {
+        if (&lr != &r && !lr.has(key) && r.has(key)) lr.values().fields[key] = *r.values().get(key);
+      }
+      std::istringstream in(names);
+      std::string source;
+      while (in >> source) {
+        ParamReader& container = lr.has(source) ? lr : r;
+        const ParamValue* sv = container.values().get(source);
+        if (!sv || sv->type != ParamValue::Type::kMap) {
+          throw ParamError("observation source \"" + source + "\" is listed in " + lr.where("observation_sources") + " but " +
+                           container.where(source) + " is not a dict of its parameters");
+        }
+        container.markRead(source);
+        o.sources.push_back(readSource(source, *sv, lr, warn));
+        skip.insert(source);
+        sub_namespaces.insert(source);
+      }
+      o.track_unknown_space =
+          fallback(lr, r, "track_unknown_space", [](ParamReader& p) { return p.boolean("track_unknown_space", false); });
+      o.footprint_clearing_enabled = fallback(lr, r, "footprint_clearing_enabled",
+                                              [](ParamReader& p) { return p.boolean("footprint_clearing_enabled", true); });
+      o.combination_method =
+          static_cast<int>(fallback(lr, r, "combination_method", [](ParamReader& p) { return p.integer("combination_method", 1); }));
+      o.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      c.obstacle_layer = o;
+    } else {
+      InflationLayerConfig f;
+      f.name = layer_name;
+      f.inflation_radius =
+          fallback(lr, r, "inflation_radius", [](ParamReader& p) { return p.number("inflation_radius", 0.55, 0.0); });
+      f.cost_scaling_factor =
+          fallback(lr, r, "cost_scaling_factor", [](ParamReader& p) { return p.number("cost_scaling_factor", 10.0, 0.0); });
+      f.inflate_unknown = fallback(lr, r, "inflate_unknown", [](ParamReader& p) { return p.boolean("inflate_unknown", false); });
+      f.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      c.inflation_layer = f;
+    }
+    if (&lr != &r) lr.reportUnknown(skip);
+  }
+  // Voxel-layer keys are accepted (the layer is 2D here) but not reported as unknown.
+  for (const char* key : {"origin_z", "z_resolution", "z_voxels", "unknown_threshold", "mark_threshold", "publish_voxel_map"}) {
+    r.markRead(key);
+  }
+  std::map<std::string, std::string> elsewhere;
+  for (const auto& k : kMoveBaseKeys) elsewhere[k] = "move_base";
+  r.reportUnknown(sub_namespaces, elsewhere);
+  return c;
+}
+
+uint8_t staticCost(int8_t value, const StaticLayerConfig& p) {
+  const bool unknown = p.unknown_cost_value >= 0 ? value == p.unknown_cost_value : value < 0;
+  if (unknown) return p.track_unknown_space ? cost::kNoInformation : cost::kFree;
+  if (value >= p.lethal_cost_threshold) return cost::kLethal;
+  if (p.trinary_costmap) return cost::kFree;
+  const double scaled = std::clamp<double>(value, 0, 100) / p.lethal_cost_threshold * cost::kLethal;
+  return static_cast<uint8_t>(std::min<double>(scaled, cost::kLethal));
+}
+
+// --- LayeredCostmap ------------------------------------------------------------------------------
+
+LayeredCostmap::LayeredCostmap(const CostmapConfig& config, Warn warn)
+    : config_(config),
+      warn_(std::move(warn)),
+      static_(1, 1, config.resolution, {0, 0}),
+      obstacle_(1, 1, config.resolution, {0, 0}),
+      base_(1, 1, config.resolution, {0, 0}),
+      master_(1, 1, config.resolution, {0, 0}) {
+  const auto& ob = config_.obstacle_layer;
+  obstacle_default_ = ob && ob->track_unknown_space ? cost::kNoInformation : cost::kFree;
+  default_value_ = (config_.static_layer && config_.static_layer->track_unknown_space) || (ob && ob->track_unknown_space)
+                       ? cost::kNoInformation
+                       : cost::kFree;
+  if (config_.inflation_layer) {
+    inflation_.inscribed_radius = config_.inscribed_radius;
+    inflation_.inflation_radius = config_.inflation_layer->inflation_radius;
+    inflation_.cost_scaling_factor = config_.inflation_layer->cost_scaling_factor;
+    inflation_.inflate_unknown = config_.inflation_layer->inflate_unknown;
+  }
+  if (config_.rolling_window || !config_.static_layer) {
+    resize(std::max(1, static_cast<int>(std::lround(config_.width / config_.resolution))),
+           std::max(1, static_cast<int>(std::lround(config_.height / config_.resolution))),
+           {config_.origin_x, config_.origin_y}, config_.resolution);
+  } else {
+    resize(1, 1, {config_.origin_x, config_.origin_y}, config_.resolution);  // sized by the first map
+  }
+  if (ob) {
+    observations_.resize(ob->sources.size());
+    height_warned_.assign(ob->sources.size(), false);
+  }
+}
+
+void LayeredCostmap::resize(int width, int height, const Eigen::Vector2d& origin, double resolution) {
+  obstacle_ = Costmap(width, height, resolution, origin, config_.obstacle_layer ? obstacle_default_ : cost::kFree);
+  base_ = Costmap(width, height, resolution, origin, default_value_);
+  master_ = Costmap(width, height, resolution, origin, default_value_);
+  full_ = true;
+}
+
+int LayeredCostmap::sourceIndex(const std::string& name) const {
+  if (!config_.obstacle_layer) return -1;
+  const auto& s = config_.obstacle_layer->sources;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void LayeredCostmap::setMap(const std::vector<int8_t>& data, int width, int height, const Eigen::Vector2d& origin,
+                            double resolution) {
+  if (!config_.static_layer) return;
+  if (config_.static_layer->first_map_only && map_received_) return;
+  if (width <= 0 || height <= 0 || data.size() != static_cast<std::size_t>(width) * height) {
+    throw std::invalid_argument("setMap: " + std::to_string(data.size()) + " cells for " + std::to_string(width) + " x " +
+                                std::to_string(height));
+  }
+  const bool same_geometry = static_valid_ && static_.width() == width && static_.height() == height &&
+                             std::abs(static_.resolution() - resolution) < 1e-9 && (static_.origin() - origin).norm() < 1e-9;
+  Costmap incoming(width, height, resolution, origin);
+  for (std::size_t i = 0; i < data.size(); ++i) incoming.costs()[i] = staticCost(data[i], *config_.static_layer);
+  if (same_geometry && !config_.rolling_window) {
+    // Only the cells that differ from the last map need recomposing.
+    CellWindow changed;
+    const auto& a = static_.costs();
+    const auto& b = incoming.costs();
+    for (int y = 0; y < height; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * width;
+      if (std::equal(a.begin() + row, a.begin() + row + width, b.begin() + row)) continue;
+      int x0 = 0, x1 = width - 1;
+      while (a[row + x0] == b[row + x0]) ++x0;
+      while (a[row + x1] == b[row + x1]) --x1;
+      changed = changed.unite(CellWindow{x0, y, x1 + 1, y + 1});
+    }
+    dirty_ = dirty_.unite(changed);
+  } else if (config_.rolling_window) {
+    full_ = true;
+  }
+  static_ = std::move(incoming);
+  static_valid_ = true;
+  map_received_ = true;
+  if (!config_.rolling_window && !same_geometry &&
+      (master_.width() != width || master_.height() != height || std::abs(master_.resolution() - resolution) > 1e-9 ||
+       (master_.origin() - origin).norm() > 1e-9)) {
+    // The master follows the map's geometry (SLAM grows it); obstacles keep their world places.
+    const Costmap old = obstacle_;
+    resize(width, height, origin, resolution);
+    if (std::abs(old.resolution() - resolution) < 1e-9) {
+      const int dx = static_cast<int>(std::lround((old.origin().x() - origin.x()) / resolution));
+      const int dy = static_cast<int>(std::lround((old.origin().y() - origin.y()) / resolution));
+      for (int y = 0; y < old.height(); ++y) {
+        const int ny = y + dy;
+        if (ny < 0 || ny >= height) continue;
+        for (int x = 0; x < old.width(); ++x) {
+          const int nx = x + dx;
+          if (nx >= 0 && nx < width) obstacle_.setCost({nx, ny}, old.cost({x, y}));
+        }
+      }
+    }
+  } else if (!same_geometry) {
+    full_ = true;
+  }
+}
+
+bool LayeredCostmap::addScan(std::size_t source, double stamp, const Eigen::Vector3d& sensor_pose, double sensor_height,
+                             const LaserScan& scan) {
+  const auto& src = config_.obstacle_layer->sources.at(source);
+  if (sensor_height < src.min_obstacle_height || sensor_height > src.max_obstacle_height) {
+    if (!height_warned_[source]) {
+      height_warned_[source] = true;
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "observation source %s: the sensor is %.3f m high, outside [min_obstacle_height %.3f, "
+                    "max_obstacle_height %.3f], so none of its points mark or clear anything",
+                    src.name.c_str(), sensor_height, src.min_obstacle_height, src.max_obstacle_height);
+      if (warn_) warn_(buf);
+    }
+    return false;
+  }
+  auto& buf = observations_[source];
+  if (src.observation_persistence == 0.0) buf.clear();
+  buf.push_back({stamp, sensor_pose, scan});
+  while (src.observation_persistence > 0.0 && !buf.empty() && stamp - buf.front().stamp > src.observation_persistence) {
+    buf.erase(buf.begin());
+  }
+  return true;
+}
+
+std::vector<std::string> LayeredCostmap::staleSources(double now) const {
+  std::vector<std::string> stale;
+  if (!config_.obstacle_layer) return stale;
+  const auto& sources = config_.obstacle_layer->sources;
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    if (sources[i].expected_update_rate <= 0.0) continue;
+    const auto& buf = observations_[i];
+    if (buf.empty() || now - buf.back().stamp > sources[i].expected_update_rate) stale.push_back(sources[i].name);
+  }
+  return stale;
+}
+
+CellWindow LayeredCostmap::cellsAround(const Eigen::Vector2d& centre, double radius_m) const {
+  const Cell lo = obstacle_.worldToCell(centre - Eigen::Vector2d::Constant(radius_m));
+  const Cell hi = obstacle_.worldToCell(centre + Eigen::Vector2d::Constant(radius_m));
+  return CellWindow{lo.x, lo.y, hi.x + 1, hi.y + 1}.grown(0, obstacle_.width(), obstacle_.height());
+}
+
+void LayeredCostmap::compose(const CellWindow& w) {
+  const int width = base_.width();
+  const bool use_static = config_.static_layer && config_.static_layer->enabled && static_valid_;
+  const bool same_grid = use_static && !config_.rolling_window;
+  for (int y = w.y0; y < w.y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    uint8_t* b = base_.costs().data() + row;
+    if (same_grid) {
+      std::copy(static_.costs().begin() + row + w.x0, static_.costs().begin() + row + w.x1, b + w.x0);
+    } else if (use_static) {
+      // Nearest-cell resampling of the map into the rolling window.
+      const double wy = base_.origin().y() + (y + 0.5) * base_.resolution();
+      const int sy = static_cast<int>(std::floor((wy - static_.origin().y()) / static_.resolution()));
+      for (int x = w.x0; x < w.x1; ++x) {
+        const double wx = base_.origin().x() + (x + 0.5) * base_.resolution();
+        const int sx = static_cast<int>(std::floor((wx - static_.origin().x()) / static_.resolution()));
+        b[x] = static_.contains({sx, sy}) ? static_.cost({sx, sy}) : default_value_;
+      }
+    } else {
+      std::fill(b + w.x0, b + w.x1, default_value_);
+    }
+    if (config_.obstacle_layer && config_.obstacle_layer->enabled) {
+      const uint8_t* o = obstacle_.costs().data() + row;
+      const bool overwrite = config_.obstacle_layer->combination_method == 0;
+      for (int x = w.x0; x < w.x1; ++x) {
+        if (o[x] == cost::kNoInformation) continue;
+        if (overwrite || b[x] == cost::kNoInformation || o[x] > b[x]) b[x] = o[x];  // updateWithMax
+      }
+    }
+  }
+}
+
+CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
+  if (config_.rolling_window) {
+    const Eigen::Vector2d origin(robot_pose.x() - master_.width() * master_.resolution() / 2.0,
+                                 robot_pose.y() - master_.height() * master_.resolution() / 2.0);
+    const Eigen::Vector2d before = obstacle_.origin();
+    obstacle_.moveOrigin(origin, obstacle_default_);
+    if ((obstacle_.origin() - before).norm() > 1e-12) {
+      base_ = Costmap(obstacle_.width(), obstacle_.height(), obstacle_.resolution(), obstacle_.origin(), default_value_);
+      master_ = Costmap(obstacle_.width(), obstacle_.height(), obstacle_.resolution(), obstacle_.origin(), default_value_);
+      full_ = true;
+    }
+  }
+  const auto& ob = config_.obstacle_layer;
+  if (ob && ob->enabled) {
+    for (std::size_t i = 0; i < observations_.size(); ++i) {
+      const auto& src = ob->sources[i];
+      ObservationSourceParams p;
+      p.obstacle_range = src.obstacle_range;
+      p.raytrace_range = src.raytrace_range;
+      p.marking = src.marking;
+      p.clearing = src.clearing;
+      p.inf_is_valid = src.inf_is_valid;
+      for (const auto& obs : observations_[i]) {
+        // Clearing and marking in one pass per scan, as ObstacleLayer does per cloud.
+        updateWithScan(obstacle_, obs.pose, obs.scan, p);
+        const double reach = std::min(std::max(src.raytrace_range, src.obstacle_range), obs.scan.range_max_m);
+        dirty_ = dirty_.unite(cellsAround(obs.pose.head<2>(), reach + obstacle_.resolution()));
+      }
+      // A scan marks once (costmap_2d re-marks only what observation_persistence keeps).
+      if (src.observation_persistence == 0.0) observations_[i].clear();
+    }
+    if (ob->footprint_clearing_enabled) {
+      for (const Cell& cell : footprintCells(obstacle_, robot_pose, config_.footprint)) {
+        if (obstacle_.contains(cell)) obstacle_.setCost(cell, cost::kFree);
+      }
+      dirty_ = dirty_.unite(cellsAround(robot_pose.head<2>(), config_.circumscribed_radius + obstacle_.resolution()));
+    }
+  }
+  const int w = master_.width(), h = master_.height();
+  CellWindow window = full_ ? CellWindow{0, 0, w, h} : dirty_.grown(0, w, h);
+  if (!window.empty()) {
+    compose(window);
+    const bool inflating = config_.inflation_layer && config_.inflation_layer->enabled;
+    const int reach = inflating ? static_cast<int>(std::ceil(inflation_.inflation_radius / master_.resolution())) : 0;
+    window = window.grown(reach, w, h);  // cells whose inflation the change may alter
+    if (inflating) {
+      inflateWindow(base_, master_, window, inflation_);
+    } else {
+      for (int y = window.y0; y < window.y1; ++y) {
+        const std::size_t row = static_cast<std::size_t>(y) * w;
+        std::copy(base_.costs().begin() + row + window.x0, base_.costs().begin() + row + window.x1,
+                  master_.costs().begin() + row + window.x0);
+      }
+    }
+  }
+  dirty_ = CellWindow{};
+  full_ = false;
+  return window;
+}
+
+void LayeredCostmap::resetObstacles(const std::optional<Eigen::Vector3d>& keep) {
+  const Costmap old = obstacle_;
+  obstacle_.fill(obstacle_default_);
+  if (keep) {
+    const double half = keep->z() / 2.0, res = obstacle_.resolution();
+    const int x0 = static_cast<int>(std::floor((keep->x() - half - obstacle_.origin().x()) / res));
+    const int y0 = static_cast<int>(std::floor((keep->y() - half - obstacle_.origin().y()) / res));
+    const int x1 = static_cast<int>(std::ceil((keep->x() + half - obstacle_.origin().x()) / res));
+    const int y1 = static_cast<int>(std::ceil((keep->y() + half - obstacle_.origin().y()) / res));
+    for (int y = std::max(y0, 0); y < std::min(y1, obstacle_.height()); ++y) {
+      for (int x = std::max(x0, 0); x < std::min(x1, obstacle_.width()); ++x) obstacle_.setCost({x, y}, old.cost({x, y}));
+    }
+  }
+  full_ = true;
+}
+
+}  // namespace core
+}  // namespace mbot

@@ -1,0 +1,165 @@
+#include "mbot_slam_navigation/core/move_base_config.h"
+
+#include <map>
+#include <set>
+#include <tuple>
+#include <algorithm>
+#include <cmath>
+
+namespace mbot {
+namespace core {
+namespace {
+const std::map<std::string, std::string> kGlobalPlanners = {{"navfn/NavfnROS", "NavfnROS"},
+                                                            {"global_planner/GlobalPlanner", "GlobalPlanner"}};
+const std::map<std::string, std::string> kLocalPlanners = {{"base_local_planner/TrajectoryPlannerROS", "TrajectoryPlannerROS"},
+                                                           {"dwa_local_planner/DWAPlannerROS", "DWAPlannerROS"}};
+const std::vector<std::string> kRecoveryTypes = {"clear_costmap_recovery/ClearCostmapRecovery", "rotate_recovery/RotateRecovery",
+                                                 "mbot_slam_navigation/BackUpRecovery", "moveback_recovery/MoveBackRecovery"};
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+std::vector<std::string> keysOf(const std::map<std::string, std::string>& m) {
+  std::vector<std::string> out;
+  for (const auto& [k, _] : m) out.push_back(k);
+  return out;
+}
+RecoveryKind kindOf(const std::string& type) {
+  if (type == kRecoveryTypes[0]) return RecoveryKind::kClearCostmap;
+  if (type == kRecoveryTypes[1]) return RecoveryKind::kRotate;
+  return RecoveryKind::kBackUp;
+}
+}  // namespace
+
+MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& ns, const Warn& warn, double circumscribed_radius) {
+  MoveBaseConfig c;
+  ParamReader r(values, ns, warn);
+  c.controller_frequency = r.number("controller_frequency", 20.0, std::nullopt, true);
+  c.planner_frequency = r.number("planner_frequency", 0.0, 0.0);
+  c.controller_patience = r.number("controller_patience", 15.0, 0.0);
+  c.planner_patience = r.number("planner_patience", 5.0, 0.0);
+  c.max_planning_retries = r.integer("max_planning_retries", -1);
+  c.oscillation_timeout = r.number("oscillation_timeout", 20.0, 0.0);
+  c.oscillation_distance = r.number("oscillation_distance", 0.5, 0.0);
+  c.recovery_behavior_enabled = r.boolean("recovery_behavior_enabled", true);
+  c.clearing_rotation_allowed = r.boolean("clearing_rotation_allowed", true);
+  c.shutdown_costmaps = r.boolean("shutdown_costmaps", false);
+  c.conservative_reset_dist = r.number("conservative_reset_dist", 3.0, 0.0);
+  c.make_plan_clear_costmap = r.boolean("make_plan_clear_costmap", true);
+  c.make_plan_add_unreachable_goal = r.boolean("make_plan_add_unreachable_goal", true);
+  c.global_type = r.string("base_global_planner", "navfn/NavfnROS");
+  c.local_type = r.string("base_local_planner", "base_local_planner/TrajectoryPlannerROS");
+  for (const auto& [key, value, known] : {std::make_tuple("base_global_planner", c.global_type, &kGlobalPlanners),
+                                          std::make_tuple("base_local_planner", c.local_type, &kLocalPlanners)}) {
+    if (known->count(value)) continue;
+    const std::string guess = nearestKey(value, keysOf(*known));
+    throw ParamError("parameter " + r.where(key) + ": unknown planner \"" + value + "\"" +
+                     (guess.empty() ? "" : " (did you mean " + guess + "?)") + "; this move_base provides " + joined(keysOf(*known)));
+  }
+  c.global_ns = kGlobalPlanners.at(c.global_type);
+  c.local_ns = kLocalPlanners.at(c.local_type);
+
+  // Global planner: navfn's keys (NavfnROS) or global_planner's (GlobalPlanner: use_dijkstra).
+  const ParamValue* gv = r.values().get(c.global_ns);
+  ParamReader g(gv ? *gv : ParamValue::ofMap(), r.where(c.global_ns), warn);
+  c.planner.use_astar = c.global_ns == "GlobalPlanner" ? !g.boolean("use_dijkstra", true)
+                                                       : g.boolean("use_astar", false);  // ours; navfn is Dijkstra only
+  c.planner.allow_unknown = g.boolean("allow_unknown", true);
+  c.planner.default_tolerance = g.number("default_tolerance", 0.0, 0.0);
+  for (const char* key : {"visualize_potential", "planner_window_x", "planner_window_y", "planner_costmap_publish_frequency",
+                          "use_quadratic", "use_grid_path", "old_navfn_behavior", "lethal_cost", "neutral_cost", "cost_factor",
+                          "publish_potential", "orientation_mode", "orientation_window_size", "outline_map"}) {
+    g.raw(key);
+  }
+  g.reportUnknown();
+
+  // Local planner.
+  if (c.local_ns == "DWAPlannerROS") {
+    warn(r.where("base_local_planner") +
+         ": DWAPlannerROS is served by TrajectoryPlannerROS with dwa: true, reading the DWAPlannerROS namespace");
+  }
+  const ParamValue* lv = r.values().get(c.local_ns);
+  ParamValue local = lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap();
+  if (c.local_ns == "DWAPlannerROS" && !local.get("dwa")) local.fields["dwa"] = ParamValue::ofBool(true);
+  readLocalPlannerParams(local, r.where(c.local_ns), warn, c.controller_frequency, c.local, c.local_ros);
+
+  // Recoveries.
+  std::vector<RecoveryConfig> out;
+  if (r.has("recovery_behaviors")) {
+    const ParamValue spec = r.raw("recovery_behaviors");
+    bool ok = spec.type == ParamValue::Type::kList;
+    for (const auto& b : spec.items) {
+      const ParamValue* n = b.get("name");
+      const ParamValue* t = b.get("type");
+      ok = ok && n && t && n->type == ParamValue::Type::kString && t->type == ParamValue::Type::kString;
+    }
+    if (!ok) {
+      throw ParamError("parameter " + r.where("recovery_behaviors") + " must be a list of {name: ..., type: ...}, got " + spec.repr());
+    }
+    for (const auto& b : spec.items) {
+      RecoveryConfig rc;
+      rc.name = b.get("name")->s;
+      rc.type = b.get("type")->s;
+      if (std::find(kRecoveryTypes.begin(), kRecoveryTypes.end(), rc.type) == kRecoveryTypes.end()) {
+        const std::string guess = nearestKey(rc.type, kRecoveryTypes);
+        throw ParamError("parameter " + r.where("recovery_behaviors") + ": unknown recovery type \"" + rc.type + "\"" +
+                         (guess.empty() ? "" : " (did you mean " + guess + "?)") + "; known: " + joined(kRecoveryTypes));
+      }
+      out.push_back(rc);
+    }
+  } else {
+    const std::vector<std::pair<std::string, int>> defaults = {
+        {"conservative_reset", 0}, {"rotate_recovery", 1}, {"back_up", 2}, {"aggressive_reset", 0}, {"rotate_recovery", 1}};
+    for (const auto& [name, type] : defaults) {
+      RecoveryConfig rc;
+      rc.name = name;
+      rc.type = kRecoveryTypes[type];
+      out.push_back(rc);
+    }
+  }
+  if (!c.clearing_rotation_allowed) {
+    out.erase(std::remove_if(out.begin(), out.end(), [](const RecoveryConfig& b) { return b.type == kRecoveryTypes[1]; }), out.end());
+  }
+  std::set<std::string> skip = {"global_costmap", "local_costmap", c.global_ns, c.local_ns};
+  for (auto& rc : out) {
+    skip.insert(rc.name);
+    rc.kind = kindOf(rc.type);
+    const ParamValue* pv = r.values().get(rc.name);
+    ParamReader pr(pv && pv->type == ParamValue::Type::kMap ? *pv : ParamValue::ofMap(), r.where(rc.name), warn);
+    if (rc.kind == RecoveryKind::kClearCostmap) {
+      const double fallback = rc.name == "conservative_reset" && !r.has("recovery_behaviors") ? c.conservative_reset_dist
+                              : rc.name == "aggressive_reset" && !r.has("recovery_behaviors") ? 4.0 * circumscribed_radius
+                                                                                              : 3.0;
+      rc.reset_distance = pr.number("reset_distance", fallback, 0.0);
+      const ParamValue names = pr.raw("layer_names");
+      if (names.type == ParamValue::Type::kList) {
+        rc.layer_names.clear();
+        for (const auto& n : names.items) {
+          if (n.type == ParamValue::Type::kString) rc.layer_names.push_back(n.s);
+        }
+      }
+      rc.affected_maps = pr.string("affected_maps", "both");
+      rc.force_updating = pr.boolean("force_updating", false);
+      rc.invert_area_to_clear = pr.boolean("invert_area_to_clear", false);
+      if (rc.affected_maps != "local" && rc.affected_maps != "global" && rc.affected_maps != "both") {
+        throw ParamError("parameter " + pr.where("affected_maps") + " must be local, global or both");
+      }
+    } else if (rc.kind == RecoveryKind::kRotate) {
+      rc.sim_granularity = pr.number("sim_granularity", 0.017, std::nullopt, true);
+      rc.frequency = pr.number("frequency", 20.0, std::nullopt, true);
+    } else {
+      rc.distance = pr.number("back_up_distance", 0.3, std::nullopt, true);
+      rc.speed = pr.number("back_up_speed", std::abs(c.local.escape_vel) > 0 ? std::abs(c.local.escape_vel) : 0.1, std::nullopt, true);
+      rc.frequency = pr.number("frequency", 20.0, std::nullopt, true);
+    }
+    pr.reportUnknown();
+  }
+  c.recoveries = out;
+  r.reportUnknown(skip);
+  return c;
+}
+
+}  // namespace core
+}  // namespace mbot

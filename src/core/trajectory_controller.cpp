@@ -1,0 +1,223 @@
+#include "mbot_slam_navigation/core/trajectory_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace mbot {
+namespace core {
+namespace {
+constexpr double kStoppedTrans = 1e-2;  // [m/s] ROS's trans_stopped_velocity
+constexpr double kStoppedRot = 1e-2;    // [rad/s] rot_stopped_velocity
+double sign(double v) { return v >= 0.0 ? 1.0 : -1.0; }
+double normalizeAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+std::string g(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
+void readLocalPlannerParams(const ParamValue& values, const std::string& ns, const Warn& warn, double controller_frequency,
+                            LocalPlannerParams& p, LocalPlannerRosParams& ros) {
+  ParamReader r(values, ns, warn);
+  p = LocalPlannerParams();
+  p.acc_lim_x = r.number("acc_lim_x", 2.5, 0.0);
+  p.acc_lim_y = r.number("acc_lim_y", 2.5, 0.0);
+  p.acc_lim_theta = r.deprecated("acc_lim_theta", "acc_lim_th", 3.2);
+  for (const char* wrong : {"acc_limit_x", "acc_limit_y", "acc_limit_th"}) {
+    if (!r.has(wrong)) continue;
+    r.markRead(wrong);
+    std::string right = wrong;
+    right.replace(0, 9, "acc_lim");
+    warn("parameter " + r.where(wrong) + " is not read; the name is " + right + " (the old documentation was wrong)");
+  }
+  p.max_vel_x = r.number("max_vel_x", 0.55, 0.0);
+  p.min_vel_x = r.number("min_vel_x", 0.0, 0.0);
+  if (r.has("max_rotational_vel")) {
+    // ROS reads it at start-up, then dynamic_reconfigure overwrites it with max/min_vel_theta.
+    r.markRead("max_rotational_vel");
+    warn("parameter " + r.where("max_rotational_vel") +
+         " has no effect in TrajectoryPlannerROS (dynamic_reconfigure replaces it with max_vel_theta / min_vel_theta); "
+         "rotate_recovery still reads it");
+  }
+  p.max_vel_theta = r.number("max_vel_theta", 1.0, 0.0);
+  p.min_vel_theta = r.number("min_vel_theta", -1.0);
+  if (p.min_vel_theta > 0) {
+    throw ParamError("parameter " + r.where("min_vel_theta") + " must be <= 0 (it is the fastest clockwise turn), got " +
+                     g(p.min_vel_theta));
+  }
+  p.min_in_place_vel_theta = r.deprecated("min_in_place_vel_theta", "min_in_place_rotational_vel", 0.4);
+  double backup = -0.1;
+  if (r.has("backup_vel")) {
+    warn("parameter " + r.where("backup_vel") + " is deprecated; use escape_vel");
+    backup = r.number("backup_vel", -0.1);
+  }
+  p.escape_vel = r.number("escape_vel", backup);
+  if (p.escape_vel >= 0) {
+    warn("parameter " + r.where("escape_vel") + " is " + g(p.escape_vel) +
+         ": a non-negative escape velocity moves the robot forward when it should back up");
+  }
+  p.sim_time = r.number("sim_time", 1.7, std::nullopt, true);
+  p.sim_granularity = r.number("sim_granularity", 0.025, std::nullopt, true);
+  p.angular_sim_granularity = r.number("angular_sim_granularity", 0.025, std::nullopt, true);
+  p.vx_samples = static_cast<int>(r.integer("vx_samples", 20));
+  p.vtheta_samples = static_cast<int>(r.integer("vtheta_samples", 20));
+  for (auto [key, value] : {std::make_pair("vx_samples", &p.vx_samples), std::make_pair("vtheta_samples", &p.vtheta_samples)}) {
+    if (*value < 1) {
+      warn("parameter " + r.where(key) + " is " + std::to_string(*value) + "; at least one sample is taken");
+      *value = 1;
+    }
+  }
+  p.path_distance_bias = r.deprecated("path_distance_bias", "pdist_scale", 0.6);
+  p.goal_distance_bias = r.deprecated("goal_distance_bias", "gdist_scale", 0.8);
+  p.occdist_scale = r.number("occdist_scale", 0.01, 0.0);
+  if (!r.has("meter_scoring")) {
+    warn("parameter " + r.where("meter_scoring") +
+         " is not set: the distance biases count cells, so the behaviour changes with the costmap resolution; set it to true");
+  }
+  p.meter_scoring = r.boolean("meter_scoring", false);
+  p.heading_lookahead = r.number("heading_lookahead", 0.325, 0.0);
+  p.heading_scoring = r.boolean("heading_scoring", false);
+  p.heading_scoring_timestep = r.number("heading_scoring_timestep", 0.1, 0.0);
+  p.oscillation_reset_dist = r.number("oscillation_reset_dist", 0.05, 0.0);
+  p.escape_reset_dist = r.number("escape_reset_dist", 0.10, 0.0);
+  p.escape_reset_theta = r.number("escape_reset_theta", M_PI / 2, 0.0);
+  p.holonomic_robot = r.boolean("holonomic_robot", true);
+  p.dwa = r.boolean("dwa", false);
+  p.simple_attractor = r.boolean("simple_attractor", false);
+  const ParamValue y_vels = r.raw("y_vels", ParamValue::ofString("-0.3,-0.1,0.1,-0.3"));
+  p.y_vels.clear();
+  bool ok = true;
+  if (y_vels.type == ParamValue::Type::kString) {
+    std::string text = y_vels.s;
+    std::replace(text.begin(), text.end(), ',', ' ');
+    std::istringstream in(text);
+    double v;
+    while (in >> v) p.y_vels.push_back(v);
+    ok = in.eof();
+  } else if (y_vels.type == ParamValue::Type::kList) {
+    for (const auto& v : y_vels.items) {
+      if (!v.isNumber()) ok = false;
+      else p.y_vels.push_back(v.number());
+    }
+  } else {
+    ok = false;
+  }
+  if (!ok) throw ParamError("parameter " + r.where("y_vels") + " must be a list of speeds, got " + y_vels.repr());
+  double frequency = r.has("controller_frequency") ? r.number("controller_frequency", controller_frequency) : controller_frequency;
+  if (frequency <= 0) {
+    warn("controller_frequency " + g(frequency) + " is not positive; the planner assumes 20 Hz");
+    frequency = 20.0;
+  }
+  p.sim_period = 1.0 / frequency;
+  ros.xy_goal_tolerance = r.number("xy_goal_tolerance", 0.10, 0.0);
+  ros.yaw_goal_tolerance = r.number("yaw_goal_tolerance", 0.05, 0.0);
+  ros.latch_xy_goal_tolerance = r.boolean("latch_xy_goal_tolerance", false);
+  ros.prune_plan = r.boolean("prune_plan", true);
+  ros.stop_time_buffer = r.number("stop_time_buffer", 0.2, 0.0);
+  const ParamValue* mrv = r.values().get("max_rotational_vel");
+  ros.max_rotational_vel = mrv && mrv->isNumber() ? mrv->number() : 1.0;
+  for (const char* key : {"world_model", "restore_defaults", "point_grid", "x_goal_tolerance", "y_goal_tolerance"}) r.markRead(key);
+  r.reportUnknown();
+}
+
+std::vector<Eigen::Vector2d> prunePlan(const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector3d& pose) {
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    if ((plan[i] - pose.head<2>()).squaredNorm() < 1.0) return {plan.begin() + static_cast<long>(i), plan.end()};
+  }
+  return plan;
+}
+
+TrajectoryController::TrajectoryController(const LocalPlannerParams& params, const LocalPlannerRosParams& ros,
+                                           const Footprint& footprint)
+    : planner_(params, footprint), ros_(ros) {}
+
+void TrajectoryController::setPlan(const std::vector<Eigen::Vector2d>& plan, double goal_yaw) {
+  plan_ = plan;
+  goal_yaw_ = goal_yaw;
+  reached_ = false;
+  latched_ = false;
+}
+
+void TrajectoryController::reset() {
+  planner_.resetOscillation();
+  rotating_to_goal_ = false;
+  reached_ = false;
+  latched_ = false;
+}
+
+bool TrajectoryController::safe(const Costmap& costmap, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel,
+                                const Eigen::Vector3d& cmd) {
+  return planner_.scoreTrajectory(costmap, pose, vel, cmd) >= 0;
+}
+
+ControlResult TrajectoryController::compute(const Costmap& costmap, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel) {
+  const LocalPlannerParams& p = planner_.params();
+  ControlResult out;
+  last_trajectory_.clear();
+  if (plan_.empty()) {
+    out.why = "no global plan";
+    return out;
+  }
+  if (ros_.prune_plan) plan_ = prunePlan(plan_, pose);
+  planner_.setPlan(plan_);
+  const Eigen::Vector2d goal = plan_.back();
+  if (latched_ || (goal - pose.head<2>()).norm() <= ros_.xy_goal_tolerance) {
+    if (ros_.latch_xy_goal_tolerance) latched_ = true;
+    const double diff = normalizeAngle(goal_yaw_ - pose.z());
+    if (std::abs(diff) <= ros_.yaw_goal_tolerance) {
+      rotating_to_goal_ = false;
+      latched_ = false;
+      reached_ = true;
+      out.valid = true;
+      return out;
+    }
+    planner_.updateGrids(costmap, pose);
+    const bool moving = std::abs(vel.x()) > kStoppedTrans || std::abs(vel.y()) > kStoppedTrans || std::abs(vel.z()) > kStoppedRot;
+    if (moving && !rotating_to_goal_) {
+      // Slow down with the acceleration limits over one control period.
+      const Eigen::Vector3d cmd(sign(vel.x()) * std::max(0.0, std::abs(vel.x()) - p.acc_lim_x * p.sim_period),
+                                sign(vel.y()) * std::max(0.0, std::abs(vel.y()) - p.acc_lim_y * p.sim_period),
+                                sign(vel.z()) * std::max(0.0, std::abs(vel.z()) - p.acc_lim_theta * p.sim_period));
+      if (safe(costmap, pose, vel, cmd)) {
+        out.valid = true;
+        out.command = cmd;
+      } else {
+        out.why = "cannot slow down safely at the goal";
+      }
+      return out;
+    }
+    rotating_to_goal_ = true;
+    double vth = diff > 0 ? std::min(p.max_vel_theta, std::max(p.min_in_place_vel_theta, diff))
+                          : std::max(p.min_vel_theta, std::min(-p.min_in_place_vel_theta, diff));
+    const double fastest = std::abs(vel.z()) + p.acc_lim_theta * p.sim_period;
+    const double slowest = std::abs(vel.z()) - p.acc_lim_theta * p.sim_period;
+    vth = sign(vth) * std::min(std::max(std::abs(vth), slowest), fastest);
+    vth = sign(vth) * std::min(std::sqrt(2 * p.acc_lim_theta * std::abs(diff)), std::abs(vth));  // stop on the yaw
+    vth = vth > 0 ? std::min(p.max_vel_theta, std::max(p.min_in_place_vel_theta, vth))
+                  : std::max(p.min_vel_theta, std::min(-p.min_in_place_vel_theta, vth));
+    const Eigen::Vector3d cmd(0.0, 0.0, vth);
+    if (safe(costmap, pose, vel, cmd)) {
+      out.valid = true;
+      out.command = cmd;
+    } else {
+      out.why = "cannot turn to the goal orientation without a collision";
+    }
+    return out;
+  }
+  rotating_to_goal_ = false;
+  const Trajectory best = planner_.findBestPath(costmap, pose, vel);
+  last_trajectory_ = best.points;
+  if (best.cost < 0) {
+    out.why = "no valid trajectory (every sampled command collides or leaves the plan)";
+    return out;
+  }
+  out.valid = true;
+  out.command = Eigen::Vector3d(best.xv, best.yv, best.thetav);
+  return out;
+}
+
+}  // namespace core
+}  // namespace mbot
