@@ -113,13 +113,12 @@ def plans():
 
 
 def local_cycles():
-    from mbot_slam_navigation.nav.trajectory_planner import local_planner_params
     import os
     import yaml
     here = os.path.dirname(os.path.abspath(__file__))
     with open(os.path.join(here, '..', 'config', 'base_local_planner_params.yaml')) as f:
         values = yaml.safe_load(f)['TrajectoryPlannerROS']
-    params, _ = local_planner_params(values, 'TrajectoryPlannerROS', lambda w: None, 10.0)
+    params, _ = _core.read_local_planner_params(values, 'TrajectoryPlannerROS', None, 10.0)
     footprint = _core._pad_footprint(_core._circle_footprint(0.2), 0.01)
     for label in ('open floor', 'doorway ahead'):
         g = np.zeros((100, 100), np.uint8)

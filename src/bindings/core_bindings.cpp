@@ -24,6 +24,8 @@
 #include "mbot_slam_navigation/core/world2d.h"
 
 namespace py = pybind11;
+
+void bindNavigation(py::module& m);  // nav_bindings.cpp
 using mbot::core::Cell;
 using mbot::core::LaserScan;
 using mbot::core::LogOddsModel;
@@ -51,6 +53,7 @@ LaserScan toScan(double angle_min, double angle_increment, double range_min, dou
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
+  bindNavigation(m);
   m.doc() = "C++ core of mbot_slam_navigation (private: use the wrappers in mbot_slam_navigation)";
 
   using mbot::core::Amcl;

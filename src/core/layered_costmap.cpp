@@ -103,8 +103,9 @@ Footprint parseFootprint(const ParamValue& value, const std::string& where) {
   return out;
 }
 
-CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& values, const Warn& warn,
+CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& values, const Warn& warn_or_empty,
                                 const std::string& ns_prefix) {
+  const Warn warn = orIgnore(warn_or_empty);
   CostmapConfig c;
   c.name = name;
   std::string prefix = ns_prefix;
@@ -275,7 +276,7 @@ uint8_t staticCost(int8_t value, const StaticLayerConfig& p) {
 
 LayeredCostmap::LayeredCostmap(const CostmapConfig& config, Warn warn)
     : config_(config),
-      warn_(std::move(warn)),
+      warn_(orIgnore(warn)),
       static_(1, 1, config.resolution, {0, 0}),
       obstacle_(1, 1, config.resolution, {0, 0}),
       base_(1, 1, config.resolution, {0, 0}),
@@ -386,7 +387,7 @@ bool LayeredCostmap::addScan(std::size_t source, double stamp, const Eigen::Vect
                     "observation source %s: the sensor is %.3f m high, outside [min_obstacle_height %.3f, "
                     "max_obstacle_height %.3f], so none of its points mark or clear anything",
                     src.name.c_str(), sensor_height, src.min_obstacle_height, src.max_obstacle_height);
-      if (warn_) warn_(buf);
+      warn_(buf);
     }
     return false;
   }

@@ -33,7 +33,9 @@ RecoveryKind kindOf(const std::string& type) {
 }
 }  // namespace
 
-MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& ns, const Warn& warn, double circumscribed_radius) {
+MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& ns, const Warn& warn_or_empty,
+                                  double circumscribed_radius) {
+  const Warn warn = orIgnore(warn_or_empty);
   MoveBaseConfig c;
   ParamReader r(values, ns, warn);
   c.controller_frequency = r.number("controller_frequency", 20.0, std::nullopt, true);

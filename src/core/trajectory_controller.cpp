@@ -19,8 +19,9 @@ std::string g(double v) {
 }
 }  // namespace
 
-void readLocalPlannerParams(const ParamValue& values, const std::string& ns, const Warn& warn, double controller_frequency,
+void readLocalPlannerParams(const ParamValue& values, const std::string& ns, const Warn& warn_or_empty, double controller_frequency,
                             LocalPlannerParams& p, LocalPlannerRosParams& ros) {
+  const Warn warn = orIgnore(warn_or_empty);
   ParamReader r(values, ns, warn);
   p = LocalPlannerParams();
   p.acc_lim_x = r.number("acc_lim_x", 2.5, 0.0);

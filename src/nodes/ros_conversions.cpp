@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <sstream>
 
 namespace mbot {
@@ -84,6 +86,53 @@ std::string nearestName(const std::string& name, const std::vector<std::string>&
     }
   }
   return best;
+}
+
+core::ParamValue fromXmlRpc(XmlRpc::XmlRpcValue& v) {
+  using core::ParamValue;
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: return ParamValue::ofBool(static_cast<bool>(v));
+    case XmlRpc::XmlRpcValue::TypeInt: return ParamValue::ofInt(static_cast<int>(v));
+    case XmlRpc::XmlRpcValue::TypeDouble: return ParamValue::ofDouble(static_cast<double>(v));
+    case XmlRpc::XmlRpcValue::TypeString: return ParamValue::ofString(static_cast<std::string>(v));
+    case XmlRpc::XmlRpcValue::TypeArray: {
+      std::vector<ParamValue> items;
+      for (int i = 0; i < v.size(); ++i) items.push_back(fromXmlRpc(v[i]));
+      return ParamValue::ofList(std::move(items));
+    }
+    case XmlRpc::XmlRpcValue::TypeStruct: {
+      std::map<std::string, ParamValue> fields;
+      for (auto it = v.begin(); it != v.end(); ++it) fields[it->first] = fromXmlRpc(it->second);
+      return ParamValue::ofMap(std::move(fields));
+    }
+    case XmlRpc::XmlRpcValue::TypeInvalid: return ParamValue();
+    default: return ParamValue::ofString(v.toXml());
+  }
+}
+
+std::pair<std::optional<double>, std::string> planarYaw(double x, double y, double z, double w, const std::string& what) {
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || !std::isfinite(w)) {
+    return {std::nullopt, what + " has NaN or infinite components"};
+  }
+  const double n = std::sqrt(x * x + y * y + z * z + w * w);
+  char buf[256];
+  if (n < 1e-6) {
+    std::snprintf(buf, sizeof buf, "%s is a zero quaternion (length %.3g); it has no heading", what.c_str(), n);
+    return {std::nullopt, buf};
+  }
+  std::string warning;
+  if (std::abs(n - 1.0) > 1e-3) {
+    std::snprintf(buf, sizeof buf, "%s (%.3f, %.3f, %.3f, %.3f) has length %.3f; normalized", what.c_str(), x, y, z, w, n);
+    warning = buf;
+  }
+  x /= n;
+  y /= n;
+  z /= n;
+  w /= n;
+  if (1.0 - 2.0 * (x * x + y * y) < 1.0 - 1e-3) {
+    return {std::nullopt, what + " tilts the robot (its z axis must stay vertical for planar navigation)"};
+  }
+  return {std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)), warning};
 }
 
 }  // namespace ros_glue

@@ -1,14 +1,18 @@
 // Pure conversions between ROS messages and core types, shared by the roscpp nodes.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nav_msgs/OccupancyGrid.h>
+#include <xmlrpcpp/XmlRpcValue.h>
 #include <sensor_msgs/LaserScan.h>
 
 #include "mbot_slam_navigation/core/laser_scan.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
+#include "mbot_slam_navigation/core/params.h"
 #include "mbot_slam_navigation/core/slam_grid.h"
 
 namespace mbot {
@@ -28,6 +32,14 @@ std::string describeScanProblem(const sensor_msgs::LaserScan& msg);
 
 /// The candidate closest to `name` by edit distance (for "unknown parameter, did you mean" warnings).
 std::string nearestName(const std::string& name, const std::vector<std::string>& candidates);
+
+/// A parameter server value as the core's ParamValue (dates and binary become strings).
+core::ParamValue fromXmlRpc(XmlRpc::XmlRpcValue& value);
+
+/// (yaw, warning) of a quaternion for planar navigation, or (nullopt, why) when it cannot be used
+/// (ROS's isQuaternionValid): NaN, zero length or tilted; one that is not unit length is normalized
+/// and the warning says so. `what` names it in the messages.
+std::pair<std::optional<double>, std::string> planarYaw(double x, double y, double z, double w, const std::string& what);
 
 }  // namespace ros_glue
 }  // namespace mbot

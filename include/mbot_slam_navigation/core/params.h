@@ -52,6 +52,11 @@ class ParamError : public std::runtime_error {
 
 using Warn = std::function<void(const std::string&)>;
 
+/// `warn`, or a callable that drops the text when `warn` is empty.
+inline Warn orIgnore(const Warn& warn) {
+  return warn ? warn : Warn([](const std::string&) {});
+}
+
 /// The known key closest in spelling to `key` (Python difflib's ratio, cutoff 0.75, as the rospy
 /// nodes did), or "" when nothing is close.
 std::string nearestKey(const std::string& key, const std::vector<std::string>& known);

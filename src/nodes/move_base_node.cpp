@@ -1,0 +1,657 @@
+// move_base (roscpp): actionlib server, planning / controlling / clearing states, recoveries, over
+// the core's costmaps, hierarchical global planner and trajectory controller.
+//
+// Interfaces as ROS's move_base: action `move_base` (move_base_msgs/MoveBaseAction),
+// `move_base_simple/goal`, `cmd_vel`, `odom` (for the robot's velocity), services `~make_plan`
+// (nav_msgs/GetPlan) and `~clear_costmaps` (std_srvs/Empty); costmaps under `~global_costmap` and
+// `~local_costmap`; plans on `~NavfnROS/plan` (and `~plan`), `~TrajectoryPlannerROS/local_plan` and
+// `~TrajectoryPlannerROS/global_plan`; the goal in use on `~current_goal`. Both costmaps beat
+// /sim_heartbeat with the robot pose's stamp under simulated time (the simulator's auto pacing).
+//
+// Differences from ROS, on purpose: a failed replan while moving stops the robot (ROS keeps
+// following the old plan, possibly through a new obstacle); oscillation detection is on by default;
+// `~make_plan` answers while a goal is active; a back-up recovery is among the defaults; every
+// abort says why.
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <actionlib/server/simple_action_server.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <move_base_msgs/MoveBaseAction.h>
+#include <nav_msgs/GetPlan.h>
+#include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <std_msgs/Header.h>
+#include <std_srvs/Empty.h>
+#include <tf2/utils.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "costmap_ros.h"
+#include "mbot_slam_navigation/core/global_planner.h"
+#include "mbot_slam_navigation/core/move_base_config.h"
+#include "mbot_slam_navigation/core/trajectory_controller.h"
+#include "ros_conversions.h"
+
+namespace mbot {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Path2 = std::vector<Eigen::Vector2d>;
+enum class State { kPlanning, kControlling, kClearing };
+enum class Trigger { kNone, kPlanning, kControlling, kOscillation };
+
+std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string fmt(const char* f, ...) {
+  char buf[1024];
+  va_list args;
+  va_start(args, f);
+  std::vsnprintf(buf, sizeof buf, f, args);
+  va_end(args);
+  return buf;
+}
+
+geometry_msgs::PoseStamped poseStamped(const std_msgs::Header& header, double x, double y, double yaw) {
+  geometry_msgs::PoseStamped p;
+  p.header = header;
+  p.pose.position.x = x;
+  p.pose.position.y = y;
+  p.pose.orientation.z = std::sin(yaw / 2.0);
+  p.pose.orientation.w = std::cos(yaw / 2.0);
+  return p;
+}
+
+Vec3 compose(const Vec3& a, const Vec3& b) {
+  const double c = std::cos(a.z()), s = std::sin(a.z());
+  return {a.x() + c * b.x() - s * b.y(), a.y() + s * b.x() + c * b.y(), std::atan2(std::sin(a.z() + b.z()), std::cos(a.z() + b.z()))};
+}
+
+class MoveBase {
+ public:
+  MoveBase()
+      : tf_(ros::Duration(30.0)),
+        listener_(tf_),
+        server_(nh_, "move_base", [this](const move_base_msgs::MoveBaseGoalConstPtr& g) { execute(g); }, false) {
+    ros::NodeHandle pnh("~");
+    if (ros::Time::isSimTime()) heartbeat_pub_ = nh_.advertise<std_msgs::Header>("/sim_heartbeat", 10);
+    auto beat = [this](const ros::Time& stamp) { beatHeartbeat(stamp); };
+    global_ = std::make_unique<ros_glue::CostmapROS>("global_costmap", tf_, beat);
+    local_ = std::make_unique<ros_glue::CostmapROS>("local_costmap", tf_, beat);
+    XmlRpc::XmlRpcValue values;
+    if (!pnh.getParam("", values)) values = XmlRpc::XmlRpcValue();
+    config_ = core::readMoveBaseConfig(ros_glue::fromXmlRpc(values), ros::this_node::getName(),
+                                       [](const std::string& t) { ROS_WARN("%s", t.c_str()); },
+                                       local_->config().circumscribed_radius);
+    planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);
+    service_planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);  // ~make_plan, not racing the loop
+    controller_ = std::make_unique<core::TrajectoryController>(config_.local, config_.local_ros, local_->config().footprint);
+
+    cmd_pub_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 1);
+    plan_pub_ = pnh.advertise<nav_msgs::Path>(config_.global_ns + "/plan", 1, true);
+    generic_plan_pub_ = pnh.advertise<nav_msgs::Path>("plan", 1, true);
+    local_plan_pub_ = pnh.advertise<nav_msgs::Path>(config_.local_ns + "/local_plan", 1);
+    local_global_plan_pub_ = pnh.advertise<nav_msgs::Path>(config_.local_ns + "/global_plan", 1);
+    goal_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("current_goal", 1, true);
+    action_goal_pub_ = nh_.advertise<move_base_msgs::MoveBaseActionGoal>("move_base/goal", 1);
+    odom_sub_ = nh_.subscribe("odom", 1, &MoveBase::onOdom, this);
+    simple_goal_sub_ = nh_.subscribe("move_base_simple/goal", 1, &MoveBase::onSimpleGoal, this);
+    make_plan_srv_ = pnh.advertiseService("make_plan", &MoveBase::onMakePlan, this);
+    clear_srv_ = pnh.advertiseService("clear_costmaps", &MoveBase::onClearCostmaps, this);
+    if (config_.shutdown_costmaps) {
+      global_->stop();
+      local_->stop();
+    }
+    server_.start();
+    std::string recoveries;
+    for (const auto& r : config_.recoveries) recoveries += (recoveries.empty() ? "" : ", ") + r.name;
+    ROS_INFO("move_base ready: global planner %s (%s), local planner %s%s, recoveries %s", config_.global_type.c_str(),
+             config_.planner.use_astar ? "A*" : "Dijkstra", config_.local_type.c_str(), config_.local.dwa ? " (DWA)" : "",
+             config_.recovery_behavior_enabled ? recoveries.c_str() : "disabled");
+  }
+
+ private:
+  // --- inputs -------------------------------------------------------------------------------------
+  void beatHeartbeat(const ros::Time& stamp) {
+    if (!heartbeat_pub_ || stamp.isZero()) return;
+    std_msgs::Header h;
+    h.stamp = stamp;
+    h.frame_id = ros::this_node::getName();
+    heartbeat_pub_.publish(h);
+  }
+
+  void onOdom(const nav_msgs::Odometry::ConstPtr& msg) {
+    std::lock_guard<std::mutex> guard(velocity_mutex_);
+    velocity_ = Vec3(msg->twist.twist.linear.x, msg->twist.twist.linear.y, msg->twist.twist.angular.z);
+  }
+
+  Vec3 velocity() {
+    std::lock_guard<std::mutex> guard(velocity_mutex_);
+    return velocity_;
+  }
+
+  void onSimpleGoal(const geometry_msgs::PoseStamped::ConstPtr& msg) {
+    ROS_INFO("move_base: a goal from move_base_simple/goal (rviz 2D Nav Goal)");
+    move_base_msgs::MoveBaseActionGoal goal;
+    goal.header.stamp = ros::Time::now();
+    goal.goal.target_pose = *msg;
+    action_goal_pub_.publish(goal);
+  }
+
+  /// The pose as (x, y, yaw) in `frame` (tf2 for another frame), or nullopt with `why`.
+  /// heading_required false (make_plan requests, which often leave the orientation all zero) reads a
+  /// zero quaternion as yaw 0 instead of refusing it.
+  std::optional<Vec3> inFrame(const geometry_msgs::PoseStamped& pose, const std::string& frame, std::string& why,
+                              bool heading_required = true) {
+    const auto& o = pose.pose.orientation;
+    double yaw = 0.0;
+    if (heading_required || o.x != 0.0 || o.y != 0.0 || o.z != 0.0 || o.w != 0.0) {
+      const auto [y, note] = ros_glue::planarYaw(o.x, o.y, o.z, o.w, "the goal orientation");
+      if (!y) {
+        why = note;
+        return std::nullopt;
+      }
+      if (!note.empty()) ROS_WARN("move_base: %s", note.c_str());
+      yaw = *y;
+    }
+    Vec3 goal(pose.pose.position.x, pose.pose.position.y, yaw);
+    if (!goal.allFinite()) {
+      why = "the goal position is not finite";
+      return std::nullopt;
+    }
+    std::string source = pose.header.frame_id;
+    while (!source.empty() && source[0] == '/') source.erase(0, 1);
+    if (source.empty()) {
+      why = "the goal has an empty frame_id";
+      return std::nullopt;
+    }
+    if (source != frame) {
+      geometry_msgs::TransformStamped t;
+      try {
+        t = tf_.lookupTransform(frame, source, ros::Time(0), ros::Duration(0.5));
+      } catch (const tf2::TransformException& e) {
+        why = "cannot transform the goal from frame \"" + source + "\" to \"" + frame + "\": " + e.what();
+        return std::nullopt;
+      }
+      goal = compose(Vec3(t.transform.translation.x, t.transform.translation.y, tf2::getYaw(t.transform.rotation)), goal);
+    }
+    return goal;
+  }
+
+  // --- planning -------------------------------------------------------------------------------------
+  /// Plans on the global costmap; false with `why` when there is no plan.
+  bool plan(core::GlobalPlanner& planner, const Vec3& start, const Vec3& goal, Path2& path, std::string& why) {
+    double resolution;
+    core::Plan p;
+    {
+      auto guard = global_->lock();
+      p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
+      resolution = global_->master().resolution();
+    }
+    if (p.status != core::PlanStatus::kOk) {
+      why = std::string(core::toString(p.status)) + ": " + p.message;
+      return false;
+    }
+    path = std::move(p.path);
+    // navfn ends its plan on the goal pose itself.
+    if (!path.empty() && (path.back() - goal.head<2>()).norm() <= resolution) path.push_back(goal.head<2>());
+    return true;
+  }
+
+  void publishPath(const std::vector<ros::Publisher*>& pubs, const Path2& path, const std::string& frame,
+                   std::optional<double> yaw = std::nullopt) {
+    nav_msgs::Path msg;
+    msg.header.stamp = ros::Time::now();
+    msg.header.frame_id = frame;
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      msg.poses.push_back(poseStamped(msg.header, path[i].x(), path[i].y(), yaw && i + 1 == path.size() ? *yaw : 0.0));
+    }
+    for (auto* pub : pubs) pub->publish(msg);
+  }
+
+  bool onMakePlan(nav_msgs::GetPlan::Request& req, nav_msgs::GetPlan::Response& resp) {
+    const std::string frame = global_->config().global_frame;
+    resp.plan.header.frame_id = frame;
+    resp.plan.header.stamp = ros::Time::now();
+    std::string why;
+    std::optional<Vec3> start;
+    if (!req.start.header.frame_id.empty()) {
+      start = inFrame(req.start, frame, why, false);
+    } else {
+      start = global_->lookupRobotPose();
+      if (!start) why = global_->tfProblem();
+    }
+    const auto goal = start ? inFrame(req.goal, frame, why, false) : std::nullopt;
+    if (!start || !goal) {
+      ROS_ERROR("make_plan: %s", why.c_str());
+      return true;
+    }
+    Path2 path;
+    bool ok;
+    {
+      std::lock_guard<std::mutex> guard(service_mutex_);
+      const double tolerance = std::max<double>(req.tolerance, config_.planner.default_tolerance);
+      if (tolerance != config_.planner.default_tolerance) {
+        core::PlannerParams p = config_.planner;
+        p.default_tolerance = tolerance;
+        core::GlobalPlanner planner(p);
+        ok = plan(planner, *start, *goal, path, why);
+      } else {
+        ok = plan(*service_planner_, *start, *goal, path, why);
+      }
+    }
+    if (!ok) {
+      ROS_WARN("make_plan: no plan from (%.2f, %.2f) to (%.2f, %.2f): %s", start->x(), start->y(), goal->x(), goal->y(), why.c_str());
+      return true;
+    }
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      resp.plan.poses.push_back(poseStamped(resp.plan.header, path[i].x(), path[i].y(), i + 1 == path.size() ? goal->z() : 0.0));
+    }
+    return true;
+  }
+
+  bool onClearCostmaps(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    global_->resetLayers();
+    local_->resetLayers();
+    ROS_INFO("move_base: costmaps cleared");
+    return true;
+  }
+
+  // --- the action ------------------------------------------------------------------------------------
+  void stop() { cmd_pub_.publish(geometry_msgs::Twist()); }
+
+  std::optional<Vec3> accept(const geometry_msgs::PoseStamped& target) {
+    std::string why;
+    const auto goal = inFrame(target, global_->config().global_frame, why);
+    if (!goal) {
+      server_.setAborted(move_base_msgs::MoveBaseResult(),
+                         "Aborting on goal because it was sent with an invalid quaternion or frame: " + why);
+      ROS_ERROR("move_base: goal rejected: %s", why.c_str());
+      return std::nullopt;
+    }
+    std_msgs::Header header;
+    header.frame_id = global_->config().global_frame;
+    header.stamp = ros::Time::now();
+    goal_pub_.publish(poseStamped(header, goal->x(), goal->y(), goal->z()));
+    ROS_INFO("move_base: new goal (%.2f, %.2f, %.2f rad) in %s", goal->x(), goal->y(), goal->z(), header.frame_id.c_str());
+    return goal;
+  }
+
+  void execute(const move_base_msgs::MoveBaseGoalConstPtr& action_goal) {
+    if (config_.shutdown_costmaps) {
+      global_->start();
+      local_->start();
+    }
+    auto goal = accept(action_goal->target_pose);
+    if (!goal) return;
+    reset(*goal);
+    ros::Rate rate(config_.controller_frequency);
+    while (ros::ok()) {
+      if (server_.isPreemptRequested()) {
+        if (server_.isNewGoalAvailable()) {
+          const auto next = server_.acceptNewGoal();
+          goal = accept(next->target_pose);
+          if (!goal) {
+            stop();
+            break;
+          }
+          reset(*goal);
+        } else {
+          stop();
+          controller_->reset();
+          server_.setPreempted(move_base_msgs::MoveBaseResult(), "Goal canceled");
+          ROS_INFO("move_base: goal canceled; the robot is stopped");
+          break;
+        }
+      }
+      if (cycle(*goal)) break;
+      rate.sleep();
+    }
+    if (config_.shutdown_costmaps) {
+      global_->stop();
+      local_->stop();
+    }
+    stop();
+    if (server_.isActive()) server_.setAborted(move_base_msgs::MoveBaseResult(), "move_base is shutting down");
+  }
+
+  void reset(const Vec3& goal) {
+    const ros::Time now = ros::Time::now();
+    goal_ = goal;
+    state_ = State::kPlanning;
+    plan_.clear();
+    new_plan_ = false;
+    last_plan_time_ = ros::Time();
+    last_valid_plan_ = last_valid_control_ = last_oscillation_reset_ = now;
+    oscillation_pose_.reset();
+    planning_retries_ = 0;
+    recovery_index_ = 0;
+    trigger_ = Trigger::kNone;
+    why_.clear();
+    controller_->reset();
+  }
+
+  bool abort(const std::string& text) {
+    stop();
+    ROS_ERROR("move_base: aborting the goal: %s", text.c_str());
+    server_.setAborted(move_base_msgs::MoveBaseResult(), text);
+    return true;
+  }
+
+  bool framesDiffer() const { return local_->config().global_frame != global_->config().global_frame; }
+
+  /// One control cycle; true when the goal is finished (succeeded or aborted).
+  bool cycle(const Vec3& goal) {
+    const ros::Time now = ros::Time::now();
+    const auto pose = global_->lookupRobotPose();
+    if (!pose) {
+      stop();
+      const std::string why = "tf: " + global_->tfProblem();
+      ROS_WARN_THROTTLE(2, "move_base: cannot get the robot pose: %s", why.c_str());
+      if ((now - last_valid_control_).toSec() > config_.controller_patience) {
+        return abort(fmt("Robot pose unavailable for more than controller_patience %.1f s (%s)", config_.controller_patience, why.c_str()));
+      }
+      return false;
+    }
+    move_base_msgs::MoveBaseFeedback feedback;
+    std_msgs::Header header;
+    header.frame_id = global_->config().global_frame;
+    header.stamp = now;
+    feedback.base_position = poseStamped(header, pose->x(), pose->y(), pose->z());
+    server_.publishFeedback(feedback);
+
+    if (!oscillation_pose_ || (pose->head<2>() - oscillation_pose_->head<2>()).norm() >= config_.oscillation_distance) {
+      last_oscillation_reset_ = now;
+      oscillation_pose_ = *pose;
+      if (trigger_ == Trigger::kOscillation) recovery_index_ = 0;
+    }
+
+    const auto [current, stale_why] = local_->isCurrent();
+    if (!current) {
+      stop();
+      ROS_WARN_THROTTLE(2, "move_base: sensor data is out of date, not commanding the base for safety: %s", stale_why.c_str());
+      if ((now - last_valid_control_).toSec() > config_.controller_patience) {
+        return abort(fmt("The local costmap was not current for controller_patience %.1f s: %s", config_.controller_patience,
+                         stale_why.c_str()));
+      }
+      return false;
+    }
+
+    const bool replan_due = config_.planner_frequency > 0 && !last_plan_time_.isZero() &&
+                            (now - last_plan_time_).toSec() >= 1.0 / config_.planner_frequency;
+    if (state_ == State::kPlanning || (state_ == State::kControlling && replan_due)) {
+      Path2 path;
+      std::string why;
+      const bool ok = plan(*planner_, *pose, goal, path, why);
+      last_plan_time_ = now;
+      if (ok) {
+        plan_ = path;
+        new_plan_ = true;
+        last_valid_plan_ = now;
+        planning_retries_ = 0;
+        state_ = State::kControlling;
+        publishPath({&plan_pub_, &generic_plan_pub_}, path, global_->config().global_frame, goal.z());
+      } else {
+        why_ = why;
+        ++planning_retries_;
+        if (state_ == State::kControlling) {
+          ROS_WARN("move_base: replanning failed (%s); stopping instead of following the old plan", why.c_str());
+          state_ = State::kPlanning;
+        }
+        stop();
+        ROS_WARN_THROTTLE(2, "move_base: no plan: %s", why.c_str());
+        if ((now - last_valid_plan_).toSec() > config_.planner_patience ||
+            (config_.max_planning_retries >= 0 && planning_retries_ > config_.max_planning_retries)) {
+          state_ = State::kClearing;
+          trigger_ = Trigger::kPlanning;
+        } else {
+          return false;
+        }
+      }
+    }
+
+    if (state_ == State::kControlling) {
+      if (new_plan_) {
+        controller_->setPlan(toLocal(plan_), goal.z());
+        new_plan_ = false;
+      }
+      const auto local_pose = framesDiffer() ? local_->lookupRobotPose() : pose;
+      core::ControlResult control;
+      if (!local_pose) {
+        control.why = "tf: " + local_->tfProblem();
+      } else {
+        auto guard = local_->lock();
+        control = controller_->compute(local_->master(), *local_pose, velocity());
+      }
+      if (controller_->reached()) {
+        stop();
+        controller_->reset();
+        server_.setSucceeded(move_base_msgs::MoveBaseResult(), "Goal reached.");
+        ROS_INFO("move_base: goal reached");
+        return true;
+      }
+      publishLocal();
+      if (config_.oscillation_timeout > 0 && (now - last_oscillation_reset_).toSec() > config_.oscillation_timeout) {
+        stop();
+        why_ = fmt("moved less than oscillation_distance %.2f m in oscillation_timeout %.1f s", config_.oscillation_distance,
+                   config_.oscillation_timeout);
+        state_ = State::kClearing;
+        trigger_ = Trigger::kOscillation;
+      } else if (control.valid) {
+        geometry_msgs::Twist t;
+        t.linear.x = control.command.x();
+        t.linear.y = control.command.y();
+        t.angular.z = control.command.z();
+        cmd_pub_.publish(t);
+        last_valid_control_ = now;
+        if (trigger_ == Trigger::kControlling) recovery_index_ = 0;
+      } else {
+        why_ = control.why;
+        stop();
+        if ((now - last_valid_control_).toSec() > config_.controller_patience) {
+          state_ = State::kClearing;
+          trigger_ = Trigger::kControlling;
+        } else {
+          // No valid command: plan again from here (ROS does the same).
+          last_valid_plan_ = now;
+          planning_retries_ = 0;
+          state_ = State::kPlanning;
+          return false;
+        }
+      }
+    }
+
+    if (state_ == State::kClearing) {
+      const auto& recoveries = config_.recoveries;
+      if (trigger_ == Trigger::kPlanning && (why_.rfind("goal occupied", 0) == 0 || why_.rfind("goal off the costmap", 0) == 0)) {
+        // Turning or backing up cannot free a goal cell or bring it onto the map; only clearing
+        // the costmaps might, so the motion recoveries are skipped.
+        while (recovery_index_ < recoveries.size() && recoveries[recovery_index_].kind != core::RecoveryKind::kClearCostmap) {
+          ++recovery_index_;
+        }
+      }
+      const char* trigger_text = trigger_ == Trigger::kPlanning      ? "no valid plan"
+                                 : trigger_ == Trigger::kControlling ? "no valid control"
+                                                                     : "oscillating";
+      if (config_.recovery_behavior_enabled && recovery_index_ < recoveries.size()) {
+        const auto& r = recoveries[recovery_index_];
+        ROS_WARN("move_base: %s (%s); running recovery behaviour %s", trigger_text, why_.c_str(), r.name.c_str());
+        runRecovery(r);
+        ++recovery_index_;
+        last_oscillation_reset_ = last_valid_plan_ = last_valid_control_ = ros::Time::now();
+        planning_retries_ = 0;
+        state_ = State::kPlanning;
+        return false;
+      }
+      const char* text = trigger_ == Trigger::kPlanning ? "Failed to find a valid plan. Even after executing recovery behaviors."
+                         : trigger_ == Trigger::kControlling
+                             ? "Failed to find a valid control. Even after executing recovery behaviors."
+                             : "Robot is oscillating. Even after executing recovery behaviors.";
+      return abort(std::string(text) + " Last reason: " + why_);
+    }
+    return false;
+  }
+
+  /// The global plan in the local costmap's frame.
+  Path2 toLocal(const Path2& path) {
+    if (!framesDiffer()) return path;
+    const std::string src = global_->config().global_frame, dst = local_->config().global_frame;
+    geometry_msgs::TransformStamped t;
+    try {
+      t = tf_.lookupTransform(dst, src, ros::Time(0), ros::Duration(0.2));
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN("move_base: cannot transform the plan from %s to %s: %s", src.c_str(), dst.c_str(), e.what());
+      return {};
+    }
+    const Vec3 base(t.transform.translation.x, t.transform.translation.y, tf2::getYaw(t.transform.rotation));
+    Path2 out;
+    for (const auto& p : path) out.push_back(compose(base, Vec3(p.x(), p.y(), 0.0)).head<2>());
+    return out;
+  }
+
+  void publishLocal() {
+    const std::string frame = local_->config().global_frame;
+    if (local_plan_pub_.getNumSubscribers() && !controller_->lastTrajectory().empty()) {
+      Path2 path;
+      for (const auto& p : controller_->lastTrajectory()) path.push_back(p.head<2>());
+      publishPath({&local_plan_pub_}, path, frame);
+    }
+    if (local_global_plan_pub_.getNumSubscribers()) publishPath({&local_global_plan_pub_}, controller_->plan(), frame);
+  }
+
+  // --- recoveries --------------------------------------------------------------------------------------
+  void runRecovery(const core::RecoveryConfig& r) {
+    if (r.kind == core::RecoveryKind::kClearCostmap) {
+      std::vector<ros_glue::CostmapROS*> maps;
+      if (r.affected_maps != "local") maps.push_back(global_.get());
+      if (r.affected_maps != "global") maps.push_back(local_.get());
+      for (auto* cm : maps) {
+        const auto pose = cm->lookupRobotPose();
+        if (!pose) continue;
+        if (r.invert_area_to_clear) {
+          ROS_WARN("clear_costmap_recovery: invert_area_to_clear clears everything here");
+          cm->resetLayers();
+        } else {
+          cm->resetLayers(Vec3(pose->x(), pose->y(), r.reset_distance));
+        }
+        if (r.force_updating) cm->update();
+      }
+    } else if (r.kind == core::RecoveryKind::kRotate) {
+      rotateRecovery(r);
+    } else {
+      backUpRecovery(r);
+    }
+  }
+
+  bool footprintFree(const Vec3& pose) {
+    auto guard = local_->lock();
+    return core::footprintCost(local_->master(), pose, local_->config().footprint, true) >= 0;
+  }
+
+  /// rotate_recovery: one full turn in place, stopping before a collision.
+  void rotateRecovery(const core::RecoveryConfig& cfg) {
+    const auto& p = config_.local;
+    const double max_vel = config_.local_ros.max_rotational_vel, min_vel = p.min_in_place_vel_theta;
+    ros::Rate rate(cfg.frequency);
+    const auto start = local_->lookupRobotPose();
+    if (!start) return;
+    double turned = 0.0, last_yaw = start->z();
+    const double tolerance = 0.1;
+    while (ros::ok() && !server_.isPreemptRequested()) {
+      const auto pose = local_->lookupRobotPose();
+      if (!pose) break;
+      turned += std::abs(std::remainder(pose->z() - last_yaw, 2 * M_PI));
+      last_yaw = pose->z();
+      const double left = 2 * M_PI - turned;
+      if (left <= tolerance) break;
+      for (double sim = 0.0; sim < left; sim += cfg.sim_granularity) {  // the footprint along the rest of the turn
+        if (!footprintFree(Vec3(pose->x(), pose->y(), pose->z() + sim))) {
+          ROS_WARN("rotate_recovery: cannot rotate in place, a collision is %.2f rad ahead", sim);
+          stop();
+          return;
+        }
+      }
+      geometry_msgs::Twist t;
+      t.angular.z = std::min(std::max(std::sqrt(2 * p.acc_lim_theta * left), min_vel), max_vel);
+      cmd_pub_.publish(t);
+      rate.sleep();
+    }
+    stop();
+  }
+
+  /// Backs straight up by back_up_distance at back_up_speed while the footprint stays clear.
+  void backUpRecovery(const core::RecoveryConfig& cfg) {
+    ros::Rate rate(cfg.frequency);
+    const auto start = local_->lookupRobotPose();
+    if (!start) return;
+    while (ros::ok() && !server_.isPreemptRequested()) {
+      const auto pose = local_->lookupRobotPose();
+      if (!pose) break;
+      const double moved = (pose->head<2>() - start->head<2>()).norm();
+      if (moved >= cfg.distance) break;
+      const double step = 0.05;
+      if (!footprintFree(Vec3(pose->x() - step * std::cos(pose->z()), pose->y() - step * std::sin(pose->z()), pose->z()))) {
+        ROS_WARN("back_up recovery: an obstacle behind the robot; stopped after %.2f m", moved);
+        break;
+      }
+      geometry_msgs::Twist t;
+      t.linear.x = -cfg.speed;
+      cmd_pub_.publish(t);
+      rate.sleep();
+    }
+    stop();
+  }
+
+  ros::NodeHandle nh_;
+  tf2_ros::Buffer tf_;
+  tf2_ros::TransformListener listener_;
+  actionlib::SimpleActionServer<move_base_msgs::MoveBaseAction> server_;
+  std::unique_ptr<ros_glue::CostmapROS> global_, local_;
+  core::MoveBaseConfig config_;
+  std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
+  std::unique_ptr<core::TrajectoryController> controller_;
+  std::mutex velocity_mutex_, service_mutex_;
+  Vec3 velocity_ = Vec3::Zero();
+  ros::Publisher cmd_pub_, plan_pub_, generic_plan_pub_, local_plan_pub_, local_global_plan_pub_, goal_pub_, action_goal_pub_,
+      heartbeat_pub_;
+  ros::Subscriber odom_sub_, simple_goal_sub_;
+  ros::ServiceServer make_plan_srv_, clear_srv_;
+  // The goal's state (the action thread only).
+  Vec3 goal_ = Vec3::Zero();
+  State state_ = State::kPlanning;
+  Path2 plan_;
+  bool new_plan_ = false;
+  ros::Time last_plan_time_, last_valid_plan_, last_valid_control_, last_oscillation_reset_;
+  std::optional<Vec3> oscillation_pose_;
+  int planning_retries_ = 0;
+  std::size_t recovery_index_ = 0;
+  Trigger trigger_ = Trigger::kNone;
+  std::string why_;
+};
+
+}  // namespace
+}  // namespace mbot
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "move_base");
+  // Scans wait for their transform, the action runs in actionlib's thread: several callback threads
+  // keep the costmaps updating meanwhile.
+  ros::AsyncSpinner spinner(4);
+  std::unique_ptr<mbot::MoveBase> move_base;
+  try {
+    move_base = std::make_unique<mbot::MoveBase>();
+  } catch (const mbot::core::ParamError& e) {
+    ROS_FATAL("move_base: %s", e.what());
+    return 1;
+  }
+  spinner.start();
+  ros::waitForShutdown();
+  return 0;
+}
