@@ -11,8 +11,7 @@ import time
 
 import numpy as np
 
-from mbot_slam_navigation.grid import OccupancyGrid
-from mbot_slam_navigation.grid_laser import make_room
+from mbot_slam_navigation.grid import OccupancyGrid, make_room
 
 
 def median_rate(fn, count, runs=5):

@@ -107,3 +107,15 @@ class OccupancyGrid:
 def bresenham_line(start: Cell, end: Cell) -> List[Cell]:
     """Cells of the 8-connected line from start to end, both included."""
     return [tuple(c) for c in _core._bresenham_line(tuple(start), tuple(end))]
+
+
+def make_room(width_m: float, height_m: float, resolution_m: float) -> OccupancyGrid:
+    """A grid covering a width x height room plus one cell each side, with the walls' cells occupied
+    (a test and benchmark scene)."""
+    nx = int(round(width_m / resolution_m)) + 2
+    ny = int(round(height_m / resolution_m)) + 2
+    grid = OccupancyGrid(nx, ny, resolution_m, origin=(-resolution_m, -resolution_m))
+    for x in range(nx):
+        for y in range(ny):
+            grid.set_occupied((x, y), x in (0, nx - 1) or y in (0, ny - 1))
+    return grid

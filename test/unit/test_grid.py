@@ -4,8 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from mbot_slam_navigation.grid import LogOddsModel, OccupancyGrid, bresenham_line
-from mbot_slam_navigation.grid_laser import make_room
+from mbot_slam_navigation.grid import LogOddsModel, OccupancyGrid, bresenham_line, make_room
 
 
 def test_world_cell_round_trip_and_bounds():
