@@ -17,10 +17,6 @@ Costmap::Costmap(int width, int height, double resolution_m, const Eigen::Vector
   costs_.assign(static_cast<std::size_t>(width) * height, fill);
 }
 
-Cell Costmap::worldToCell(const Eigen::Vector2d& p) const { return core::worldToCell(origin_, resolution_, p); }
-
-Eigen::Vector2d Costmap::cellCenter(const Cell& c) const { return core::cellCenter(origin_, resolution_, c); }
-
 void Costmap::fill(uint8_t v) { std::fill(costs_.begin(), costs_.end(), v); }
 
 void Costmap::moveOrigin(const Eigen::Vector2d& new_origin, uint8_t fill) {

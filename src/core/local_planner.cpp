@@ -183,6 +183,39 @@ LocalPlanner::LocalPlanner(const LocalPlannerParams& params, const Footprint& fo
     : params_(params), footprint_(footprint), path_bias_(params.path_distance_bias), goal_bias_(params.goal_distance_bias) {
   params_.validate();
   validateFootprint(footprint_);
+  circumscribed_ = circumscribedRadius(footprint_);
+}
+
+void LocalPlanner::buildNonZeroTable(const Costmap& map) {
+  table_w_ = map.width();
+  table_h_ = map.height();
+  nonzero_.assign(static_cast<std::size_t>(table_w_ + 1) * (table_h_ + 1), 0);
+  const uint8_t* c = map.costs().data();
+  for (int y = 0; y < table_h_; ++y) {
+    int row = 0;
+    const int* above = nonzero_.data() + static_cast<std::size_t>(y) * (table_w_ + 1);
+    int* out = nonzero_.data() + static_cast<std::size_t>(y + 1) * (table_w_ + 1);
+    for (int x = 0; x < table_w_; ++x) {
+      row += c[static_cast<std::size_t>(y) * table_w_ + x] != cost::kFree;
+      out[x + 1] = above[x + 1] + row;
+    }
+  }
+}
+
+int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose) const {
+  if (table_valid_) {
+    // Every outline cell lies in the cells of the circumscribed circle's bounding square.
+    const Cell lo = map.worldToCell({pose.x() - circumscribed_, pose.y() - circumscribed_});
+    const Cell hi = map.worldToCell({pose.x() + circumscribed_, pose.y() + circumscribed_});
+    if (lo.x >= 0 && lo.y >= 0 && hi.x < table_w_ && hi.y < table_h_) {
+      const int stride = table_w_ + 1;
+      const int* t = nonzero_.data();
+      const int count = t[(hi.y + 1) * stride + hi.x + 1] - t[lo.y * stride + hi.x + 1] - t[(hi.y + 1) * stride + lo.x] +
+                        t[lo.y * stride + lo.x];
+      if (count == 0) return 0;
+    }
+  }
+  return footprintCost(map, pose, footprint_, /*unknown_is_obstacle=*/true);
 }
 
 void LocalPlanner::setPlan(const std::vector<Eigen::Vector2d>& plan) {
@@ -243,7 +276,7 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   for (int i = 0; i < steps; ++i) {
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
-    const int fp = footprintCost(map, {x, y, th}, footprint_, /*unknown_is_obstacle=*/true);
+    const int fp = footprintCostAt(map, {x, y, th});
     if (fp < 0) return;
     occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
     if (p.simple_attractor) {
@@ -299,7 +332,10 @@ double LocalPlanner::progressAt(const Costmap& map, const Eigen::Vector3d& pose)
 
 Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity) {
   updateGrids(map, pose);
+  buildNonZeroTable(map);
+  table_valid_ = true;  // only for this call's map: scoreTrajectory may get another one
   Trajectory best = createTrajectories(map, pose, velocity);
+  table_valid_ = false;
   if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;
   return best;
 }

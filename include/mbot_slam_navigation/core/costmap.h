@@ -33,8 +33,9 @@ class Costmap {
   double resolution() const { return resolution_; }
   const Eigen::Vector2d& origin() const { return origin_; }
   bool contains(const Cell& c) const { return c.x >= 0 && c.y >= 0 && c.x < width_ && c.y < height_; }
-  Cell worldToCell(const Eigen::Vector2d& p) const;
-  Eigen::Vector2d cellCenter(const Cell& c) const;
+  // Inline: the local planner converts every footprint corner of every trajectory step.
+  Cell worldToCell(const Eigen::Vector2d& p) const { return core::worldToCell(origin_, resolution_, p); }
+  Eigen::Vector2d cellCenter(const Cell& c) const { return core::cellCenter(origin_, resolution_, c); }
   std::size_t index(const Cell& c) const { return static_cast<std::size_t>(c.y) * width_ + c.x; }
 
   uint8_t cost(const Cell& c) const { return costs_[index(c)]; }

@@ -136,6 +136,11 @@ class LocalPlanner {
   double headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const;
   Trajectory createTrajectories(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel);
   void updateOscillationFlags(const Eigen::Vector3d& pose, const Trajectory& best);
+  /// footprintCost, with an exact shortcut: when no cell of the square around the footprint's
+  /// circumscribed circle has a cost above 0 (the summed-area table of non-zero cells built for
+  /// this cycle says so in four lookups), every outline cell is free and the cost is 0.
+  int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose) const;
+  void buildNonZeroTable(const Costmap& map);
   void resetFlagsIfMoved(const Eigen::Vector3d& pose);
 
   LocalPlannerParams params_;
@@ -146,6 +151,12 @@ class LocalPlanner {
   Eigen::Vector2d final_goal_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d local_goal_ = Eigen::Vector2d::Zero();
   DistanceGrid path_grid_, goal_grid_;
+  // Summed-area table of cells with a non-zero cost, (w + 1) x (h + 1); valid only inside
+  // findBestPath, for the map it was called with.
+  std::vector<int> nonzero_;
+  int table_w_ = 0, table_h_ = 0;
+  bool table_valid_ = false;
+  double circumscribed_ = 0.0;
   // ROS's oscillation suppression and escape state.
   bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
   bool rotating_left_ = false, rotating_right_ = false, strafe_left_ = false, strafe_right_ = false;
