@@ -712,6 +712,8 @@ PYBIND11_MODULE(_core, m) {
       .def("progress_at", &LocalPlanner::progressAt, py::arg("costmap"), py::arg("pose"))
       .def("update_grids", &LocalPlanner::updateGrids, py::arg("costmap"), py::arg("pose"))
       .def("reset_oscillation", &LocalPlanner::resetOscillation)
+      .def("set_shortcuts", &mbot::core::LocalPlanner::setShortcuts, py::arg("on"),
+           "false: every footprint by its full outline walk (the reference)")
       .def_property_readonly("local_goal", [](const LocalPlanner& lp) { return Eigen::Vector2d(lp.localGoal()); })
       .def_property_readonly("escaping", &LocalPlanner::escaping)
       .def("path_distances", [](const LocalPlanner& lp, const Costmap& map) {

@@ -190,29 +190,37 @@ void LocalPlanner::buildNonZeroTable(const Costmap& map) {
   table_w_ = map.width();
   table_h_ = map.height();
   nonzero_.assign(static_cast<std::size_t>(table_w_ + 1) * (table_h_ + 1), 0);
+  blocking_.assign(nonzero_.size(), 0);
   const uint8_t* c = map.costs().data();
   for (int y = 0; y < table_h_; ++y) {
-    int row = 0;
-    const int* above = nonzero_.data() + static_cast<std::size_t>(y) * (table_w_ + 1);
-    int* out = nonzero_.data() + static_cast<std::size_t>(y + 1) * (table_w_ + 1);
+    int row = 0, row_blocking = 0;
+    const std::size_t above = static_cast<std::size_t>(y) * (table_w_ + 1), here = above + table_w_ + 1;
     for (int x = 0; x < table_w_; ++x) {
-      row += c[static_cast<std::size_t>(y) * table_w_ + x] != cost::kFree;
-      out[x + 1] = above[x + 1] + row;
+      const uint8_t v = c[static_cast<std::size_t>(y) * table_w_ + x];
+      row += v != cost::kFree;
+      row_blocking += v >= cost::kLethal;  // lethal or unknown: what makes a footprint invalid
+      nonzero_[here + x + 1] = nonzero_[above + x + 1] + row;
+      blocking_[here + x + 1] = blocking_[above + x + 1] + row_blocking;
     }
   }
 }
 
-int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose) const {
+int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer) const {
   if (table_valid_) {
     // Every outline cell lies in the cells of the circumscribed circle's bounding square.
     const Cell lo = map.worldToCell({pose.x() - circumscribed_, pose.y() - circumscribed_});
     const Cell hi = map.worldToCell({pose.x() + circumscribed_, pose.y() + circumscribed_});
     if (lo.x >= 0 && lo.y >= 0 && hi.x < table_w_ && hi.y < table_h_) {
       const int stride = table_w_ + 1;
-      const int* t = nonzero_.data();
-      const int count = t[(hi.y + 1) * stride + hi.x + 1] - t[lo.y * stride + hi.x + 1] - t[(hi.y + 1) * stride + lo.x] +
-                        t[lo.y * stride + lo.x];
-      if (count == 0) return 0;
+      auto count = [&](const std::vector<int>& table) {
+        const int* t = table.data();
+        return t[(hi.y + 1) * stride + hi.x + 1] - t[lo.y * stride + hi.x + 1] - t[(hi.y + 1) * stride + lo.x] + t[lo.y * stride + lo.x];
+      };
+      if (count(nonzero_) == 0) return 0;
+      if (defer && count(blocking_) == 0) {
+        *defer = true;
+        return 0;
+      }
     }
   }
   return footprintCost(map, pose, footprint_, /*unknown_is_obstacle=*/true);
@@ -257,7 +265,7 @@ double LocalPlanner::headingDiff(const Costmap& map, const Cell& cell, const Eig
 }
 
 void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel, double vx_samp,
-                            double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj) const {
+                            double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj, double exact_below) const {
   const LocalPlannerParams& p = params_;
   const double vmag = std::hypot(vx_samp, vy_samp);
   int steps = p.heading_scoring ? static_cast<int>(p.sim_time / p.sim_granularity + 0.5)
@@ -273,10 +281,13 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   double x = pose.x(), y = pose.y(), th = pose.z();
   double vx = vel.x(), vy = vel.y(), vth = vel.z();
   double path_dist = 0.0, goal_dist = 0.0, occ = 0.0, heading = 0.0, time = 0.0;
+  // Steps whose footprint is known valid but whose outline cost was not computed (see exact_below).
+  bool deferred = false;
+  const bool may_defer = table_valid_ && std::isfinite(exact_below);
   for (int i = 0; i < steps; ++i) {
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
-    const int fp = footprintCostAt(map, {x, y, th});
+    const int fp = footprintCostAt(map, {x, y, th}, may_defer ? &deferred : nullptr);
     if (fp < 0) return;
     occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
     if (p.simple_attractor) {
@@ -306,7 +317,13 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
     time += dt;
   }
   traj.progress = path_bias_ * path_dist + goal_bias_ * goal_dist;
-  traj.cost = traj.progress + p.occdist_scale * occ + (p.heading_scoring ? 0.3 * heading : 0.0);
+  const double rest = traj.progress + (p.heading_scoring ? 0.3 * heading : 0.0);
+  traj.cost = rest + p.occdist_scale * occ;  // a lower bound while steps are deferred
+  if (deferred && traj.cost <= exact_below) {
+    // It may win: the outline costs of every step, exactly.
+    for (const Eigen::Vector3d& q : traj.points) occ = std::max(occ, static_cast<double>(footprintCost(map, q, footprint_, true)));
+    traj.cost = rest + p.occdist_scale * occ;
+  }
 }
 
 double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
@@ -332,8 +349,8 @@ double LocalPlanner::progressAt(const Costmap& map, const Eigen::Vector3d& pose)
 
 Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity) {
   updateGrids(map, pose);
-  buildNonZeroTable(map);
-  table_valid_ = true;  // only for this call's map: scoreTrajectory may get another one
+  if (shortcuts_) buildNonZeroTable(map);
+  table_valid_ = shortcuts_;  // only for this call's map: scoreTrajectory may get another one
   Trajectory best = createTrajectories(map, pose, velocity);
   table_valid_ = false;
   if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;
@@ -395,15 +412,18 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     if (t.cost >= 0 && t.xv > 0 && t.progress < progress_now - 1e-9) progressing = true;
     return t.cost >= 0 && (t.cost < best.cost || best.cost < 0);
   };
+  // Costs at or above this cannot win (the comparisons below are < best and <= best), so only the
+  // trajectories that may are scored exactly.
+  auto bar = [&]() { return best.cost < 0 || best.yv != 0.0 ? std::numeric_limits<double>::infinity() : best.cost; };
 
   if (!escaping_) {
     double vx_samp = min_vx;
     for (int i = 0; i < p.vx_samples; ++i) {
-      generate(map, pose, vel, vx_samp, 0.0, 0.0, impossible, comp);  // straight ahead, always tried
+      generate(map, pose, vel, vx_samp, 0.0, 0.0, impossible, comp, bar());  // straight ahead, always tried
       if (better(comp)) std::swap(best, comp);
       double vth_samp = min_vth;
       for (int j = 0; j < p.vtheta_samples - 1; ++j) {
-        generate(map, pose, vel, vx_samp, 0.0, vth_samp, impossible, comp);
+        generate(map, pose, vel, vx_samp, 0.0, vth_samp, impossible, comp, bar());
         if (better(comp)) std::swap(best, comp);
         vth_samp += dvth;
       }
@@ -411,7 +431,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     }
     if (p.holonomic_robot) {
       for (double vy : {0.1, -0.1}) {
-        generate(map, pose, vel, 0.1, vy, 0.0, impossible, comp);
+        generate(map, pose, vel, 0.1, vy, 0.0, impossible, comp, bar());
         if (better(comp)) std::swap(best, comp);
       }
     }
@@ -431,7 +451,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   double vth_samp = min_vth;
   for (int i = 0; i < p.vtheta_samples && !progressing; ++i) {
     const double limited = vth_samp > 0 ? std::max(vth_samp, p.min_in_place_vel_theta) : std::min(vth_samp, -p.min_in_place_vel_theta);
-    generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp);
+    generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp, bar());
     if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth) {
       const double d = goalDistanceAhead(comp);
       if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
@@ -448,7 +468,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
 
   if (p.holonomic_robot) {
     for (double vy : p.y_vels) {
-      generate(map, pose, vel, 0.0, vy, 0.0, impossible, comp);
+      generate(map, pose, vel, 0.0, vy, 0.0, impossible, comp, bar());
       if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0)) {
         const double d = goalDistanceAhead(comp);
         if (d < heading_dist && ((vy > 0 && !stuck_left_strafe_) || (vy < 0 && !stuck_right_strafe_))) {

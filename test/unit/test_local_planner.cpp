@@ -213,29 +213,36 @@ TEST(LocalPlannerParams, RejectsNonsense) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
-// The cycle's shortcut (a footprint over cells that are all free costs 0) gives exactly the cost
-// the full outline walk gives: the best trajectory of each cycle scores the same when re-scored
-// without it, among scattered obstacles, on a round and a square robot.
-TEST(LocalPlanner, TheFreeSquareShortcutScoresAsTheFullFootprintWalk) {
-  int compared = 0;
-  for (unsigned seed = 1; seed <= 4; ++seed) {
+// The cycle's shortcuts (a footprint over free cells costs 0; one over cells with no lethal or
+// unknown cell is valid and its cost is only computed if the trajectory could win) choose exactly
+// the command, and give exactly the cost, of scoring every footprint by its outline: random
+// obstacles, a round and a square robot, moving and standing.
+TEST(LocalPlanner, ShortcutsChooseExactlyAsTheFullFootprintWalk) {
+  int compared = 0, valid = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
     std::srand(seed);
     Costmap raw(100, 100, 0.05, {0, 0});
-    for (int k = 0; k < 25; ++k) raw.setCost({std::rand() % 100, std::rand() % 100}, cost::kLethal);
+    for (int k = 0; k < 10 + 5 * static_cast<int>(seed); ++k) raw.setCost({std::rand() % 100, std::rand() % 100}, cost::kLethal);
     const Costmap m = inflated(raw);
     for (const Footprint& fp : {square(), padFootprint(circleFootprint(0.2), 0.01)}) {
-      LocalPlanner lp(tutorialParams(), fp);
-      lp.setPlan(straightPlan({1.0, 1.0 + 0.6 * seed}, {4.5, 4.0}));
-      for (int trial = 0; trial < 5; ++trial) {
-        const Eigen::Vector3d pose(1.0 + 0.5 * trial, 1.0 + 0.6 * seed, 0.3 * trial);
-        if (footprintCost(m, pose, fp) < 0) continue;
-        const Trajectory best = lp.findBestPath(m, pose, {0.1, 0.0, 0.0});
-        if (best.cost < 0) continue;
-        const double exact = lp.scoreTrajectory(m, pose, {0.1, 0.0, 0.0}, {best.xv, best.yv, best.thetav});
-        EXPECT_DOUBLE_EQ(best.cost, exact) << "seed " << seed << " trial " << trial;
+      LocalPlanner fast(tutorialParams(), fp), reference(tutorialParams(), fp);
+      reference.setShortcuts(false);
+      const auto plan = straightPlan({1.0, 0.8 + 0.5 * seed}, {4.5, 4.0});
+      fast.setPlan(plan);
+      reference.setPlan(plan);
+      for (int trial = 0; trial < 8; ++trial) {
+        const Eigen::Vector3d pose(0.8 + 0.45 * trial, 0.8 + 0.5 * seed, 0.4 * trial - 1.0);
+        const Eigen::Vector3d vel(0.05 * (trial % 3), 0.0, 0.2 * (trial % 2));
+        const Trajectory a = fast.findBestPath(m, pose, vel), b = reference.findBestPath(m, pose, vel);
+        EXPECT_EQ(a.xv, b.xv) << "seed " << seed << " trial " << trial;
+        EXPECT_EQ(a.yv, b.yv) << "seed " << seed << " trial " << trial;
+        EXPECT_EQ(a.thetav, b.thetav) << "seed " << seed << " trial " << trial;
+        EXPECT_DOUBLE_EQ(a.cost, b.cost) << "seed " << seed << " trial " << trial;
         ++compared;
+        valid += a.cost >= 0;
       }
     }
   }
-  EXPECT_GE(compared, 15);
+  EXPECT_EQ(compared, 96);
+  EXPECT_GE(valid, 40);
 }

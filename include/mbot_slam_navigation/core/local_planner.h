@@ -23,6 +23,7 @@
 // are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -124,6 +125,9 @@ class LocalPlanner {
   void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
   /// Clears the oscillation and escape state (a new goal).
   void resetOscillation();
+  /// false: score every footprint by its full outline walk (the reference the shortcuts must
+  /// match exactly; for tests and benchmarks).
+  void setShortcuts(bool on) { shortcuts_ = on; }
 
   const DistanceGrid& pathGrid() const { return path_grid_; }
   const DistanceGrid& goalGrid() const { return goal_grid_; }
@@ -131,15 +135,21 @@ class LocalPlanner {
   bool escaping() const { return escaping_; }
 
  private:
+  /// Simulates and scores one command into `traj`. `exact_below`: the exact cost is only needed
+  /// when it could be <= this (within findBestPath, a trajectory that cannot beat the best so far
+  /// only needs its validity; its cost is then a lower bound above exact_below).
   void generate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel, double vx_samp,
-                double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj) const;
+                double vy_samp, double vth_samp, double impossible_cost, Trajectory& traj,
+                double exact_below = std::numeric_limits<double>::infinity()) const;
   double headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const;
   Trajectory createTrajectories(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel);
   void updateOscillationFlags(const Eigen::Vector3d& pose, const Trajectory& best);
   /// footprintCost, with an exact shortcut: when no cell of the square around the footprint's
   /// circumscribed circle has a cost above 0 (the summed-area table of non-zero cells built for
   /// this cycle says so in four lookups), every outline cell is free and the cost is 0.
-  int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose) const;
+  /// With `defer` (may be null), a footprint whose square holds no lethal or unknown cell is valid
+  /// and its cost is left for later: *defer is set and 0 returned.
+  int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer = nullptr) const;
   void buildNonZeroTable(const Costmap& map);
   void resetFlagsIfMoved(const Eigen::Vector3d& pose);
 
@@ -153,9 +163,9 @@ class LocalPlanner {
   DistanceGrid path_grid_, goal_grid_;
   // Summed-area table of cells with a non-zero cost, (w + 1) x (h + 1); valid only inside
   // findBestPath, for the map it was called with.
-  std::vector<int> nonzero_;
+  std::vector<int> nonzero_, blocking_;  // blocking_: cells that are lethal or unknown
   int table_w_ = 0, table_h_ = 0;
-  bool table_valid_ = false;
+  bool table_valid_ = false, shortcuts_ = true;
   double circumscribed_ = 0.0;
   // ROS's oscillation suppression and escape state.
   bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
