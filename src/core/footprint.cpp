@@ -58,21 +58,42 @@ void validateFootprint(const Footprint& f) {
 
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle) {
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
-  // Reused between calls: the local planner calls this for every step of every trajectory.
-  thread_local std::vector<Cell> corners;
-  corners.clear();
-  for (const auto& v : footprint) {
-    corners.push_back(map.worldToCell({pose.x() + c * v.x() - s * v.y(), pose.y() + s * v.x() + c * v.y()}));
+  // The local planner calls this for every step of every trajectory: corners in a stack array when
+  // they fit (no allocation, no thread-local lookup), cells by one multiplication each.
+  constexpr std::size_t kStack = 32;
+  Cell stack_corners[kStack];
+  thread_local std::vector<Cell> heap_corners;
+  Cell* corners = stack_corners;
+  if (footprint.size() > kStack) {
+    heap_corners.resize(footprint.size());
+    corners = heap_corners.data();
   }
+  const double inv = 1.0 / map.resolution(), ox = map.origin().x(), oy = map.origin().y();
+  Cell lo{std::numeric_limits<int>::max(), std::numeric_limits<int>::max()}, hi{std::numeric_limits<int>::min(), std::numeric_limits<int>::min()};
+  const std::size_t n = footprint.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& v = footprint[i];
+    const Cell cell{static_cast<int>(std::floor((pose.x() + c * v.x() - s * v.y() - ox) * inv)),
+                    static_cast<int>(std::floor((pose.y() + s * v.x() + c * v.y() - oy) * inv))};
+    corners[i] = cell;
+    lo = {std::min(lo.x, cell.x), std::min(lo.y, cell.y)};
+    hi = {std::max(hi.x, cell.x), std::max(hi.y, cell.y)};
+  }
+  // Every outline cell lies between the corners' cells: inside the map if they all are.
+  if (lo.x < 0 || lo.y < 0 || hi.x >= map.width() || hi.y >= map.height()) return -1;
+  const uint8_t* costs = map.costs().data();
+  const int w = map.width();
   int worst = 0;
   bool blocked = false;
-  for (std::size_t i = 0, j = corners.size() - 1; i < corners.size() && !blocked; j = i++) {
+  for (std::size_t i = 0, j = n - 1; i < n && !blocked; j = i++) {
+    // Each edge starts where the last one ended: that corner cell is visited once, by the first.
+    bool first = j != n - 1;
     walkLine(corners[j], corners[i], [&](const Cell& cell) {
-      if (!map.contains(cell)) {
-        blocked = true;
-        return false;
+      if (first) {
+        first = false;
+        return true;
       }
-      const uint8_t v = map.cost(cell);
+      const uint8_t v = costs[static_cast<std::size_t>(cell.y) * w + cell.x];
       if (v == cost::kLethal || (v == cost::kNoInformation && unknown_is_obstacle)) {
         blocked = true;
         return false;
