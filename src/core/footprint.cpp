@@ -59,7 +59,8 @@ void validateFootprint(const Footprint& f) {
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle) {
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
   // The local planner calls this for every step of every trajectory: corners in a stack array when
-  // they fit (no allocation, no thread-local lookup), cells by one multiplication each.
+  // they fit (no allocation, no thread-local lookup). Cells by division, as Costmap::worldToCell:
+  // a multiplication by 1 / resolution puts points on cell borders into the other cell.
   constexpr std::size_t kStack = 32;
   Cell stack_corners[kStack];
   thread_local std::vector<Cell> heap_corners;
@@ -68,13 +69,13 @@ int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footpri
     heap_corners.resize(footprint.size());
     corners = heap_corners.data();
   }
-  const double inv = 1.0 / map.resolution(), ox = map.origin().x(), oy = map.origin().y();
+  const double res = map.resolution(), ox = map.origin().x(), oy = map.origin().y();
   Cell lo{std::numeric_limits<int>::max(), std::numeric_limits<int>::max()}, hi{std::numeric_limits<int>::min(), std::numeric_limits<int>::min()};
   const std::size_t n = footprint.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& v = footprint[i];
-    const Cell cell{static_cast<int>(std::floor((pose.x() + c * v.x() - s * v.y() - ox) * inv)),
-                    static_cast<int>(std::floor((pose.y() + s * v.x() + c * v.y() - oy) * inv))};
+    const Cell cell{static_cast<int>(std::floor((pose.x() + c * v.x() - s * v.y() - ox) / res)),
+                    static_cast<int>(std::floor((pose.y() + s * v.x() + c * v.y() - oy) / res))};
     corners[i] = cell;
     lo = {std::min(lo.x, cell.x), std::min(lo.y, cell.y)};
     hi = {std::max(hi.x, cell.x), std::max(hi.y, cell.y)};
