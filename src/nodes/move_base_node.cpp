@@ -12,6 +12,9 @@
 // following the old plan, possibly through a new obstacle); oscillation detection is on by default;
 // `~make_plan` answers while a goal is active; a back-up recovery is among the defaults; every
 // abort says why.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -19,6 +22,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <actionlib/server/simple_action_server.h>
@@ -73,6 +77,47 @@ Vec3 compose(const Vec3& a, const Vec3& b) {
   const double c = std::cos(a.z()), s = std::sin(a.z());
   return {a.x() + c * b.x() - s * b.y(), a.y() + s * b.x() + c * b.y(), std::atan2(std::sin(a.z() + b.z()), std::cos(a.z() + b.z()))};
 }
+
+// A fixed-rate loop like ros::Rate, but under simulated time it does not poll: roscpp's sleep
+// wakes every millisecond of wall time until /clock passes the deadline (about 14 wake-ups per
+// 10 Hz cycle at 7x real time, each a context switch). This one sleeps for the wall time the
+// remaining simulated time should take at the pace /clock has been advancing, then checks again.
+// A clock that jumps back (a reset simulation) ends the wait, as ros::Rate does.
+class SimRate {
+ public:
+  explicit SimRate(double hz) : period_(1.0 / hz), next_(ros::Time::now() + period_) {}
+  void sleep() {
+    if (!ros::Time::isSimTime()) {
+      const ros::Duration left = next_ - ros::Time::now();
+      if (left > ros::Duration(0)) left.sleep();
+    } else {
+      ros::Time last = ros::Time::now();
+      ros::WallTime wall_last = ros::WallTime::now();
+      while (ros::ok() && last < next_) {
+        const double wall = std::clamp((next_ - last).toSec() / pace_.load(), 0.0005, 0.05);
+        std::this_thread::sleep_for(std::chrono::duration<double>(wall));
+        const ros::Time now = ros::Time::now();
+        const ros::WallTime wall_now = ros::WallTime::now();
+        if (now < last) break;  // the clock went back
+        const double dw = (wall_now - wall_last).toSec();
+        if (dw > 0.005 && now > last) pace_ = std::clamp((now - last).toSec() / dw, 0.05, 500.0);
+        last = now;
+        wall_last = wall_now;
+      }
+    }
+    const ros::Time now = ros::Time::now();
+    next_ += period_;
+    if (next_ < now || next_ > now + period_ * 2.0) next_ = now + period_;  // behind, or the clock jumped
+  }
+
+ private:
+  ros::Duration period_;
+  ros::Time next_;
+  // Simulated seconds per wall second, as last seen (one clock for all loops). Starting high
+  // only costs a few short first waits; starting low would oversleep.
+  static std::atomic<double> pace_;
+};
+std::atomic<double> SimRate::pace_{20.0};
 
 class MoveBase {
  public:
@@ -292,7 +337,7 @@ class MoveBase {
     auto goal = accept(action_goal->target_pose);
     if (!goal) return;
     reset(*goal);
-    ros::Rate rate(config_.controller_frequency);
+    SimRate rate(config_.controller_frequency);
     while (ros::ok()) {
       if (server_.isPreemptRequested()) {
         if (server_.isNewGoalAvailable()) {
@@ -559,7 +604,7 @@ class MoveBase {
   void rotateRecovery(const core::RecoveryConfig& cfg) {
     const auto& p = config_.local;
     const double max_vel = config_.local_ros.max_rotational_vel, min_vel = p.min_in_place_vel_theta;
-    ros::Rate rate(cfg.frequency);
+    SimRate rate(cfg.frequency);
     const auto start = local_->lookupRobotPose();
     if (!start) return;
     double turned = 0.0, last_yaw = start->z();
@@ -588,7 +633,7 @@ class MoveBase {
 
   /// Backs straight up by back_up_distance at back_up_speed while the footprint stays clear.
   void backUpRecovery(const core::RecoveryConfig& cfg) {
-    ros::Rate rate(cfg.frequency);
+    SimRate rate(cfg.frequency);
     const auto start = local_->lookupRobotPose();
     if (!start) return;
     while (ros::ok() && !server_.isPreemptRequested()) {
