@@ -219,7 +219,16 @@ int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pos
       if (count(nonzero_) == 0) return 0;
       if (defer && count(blocking_) == 0) {
         *defer = true;
-        return 0;
+        // A lower bound of the outline's cost: the costs at four of its corners (outline cells),
+        // which near a wall are usually its highest.
+        const double c = std::cos(pose.z()), s = std::sin(pose.z());
+        const std::size_t n = footprint_.size(), step = std::max<std::size_t>(1, n / 4);
+        int bound = 0;
+        for (std::size_t i = 0; i < n; i += step) {
+          const Eigen::Vector2d& v = footprint_[i];
+          bound = std::max<int>(bound, map.cost(map.worldToCell({pose.x() + c * v.x() - s * v.y(), pose.y() + s * v.x() + c * v.y()})));
+        }
+        return bound;
       }
     }
   }
@@ -277,13 +286,14 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   traj.yv = vy_samp;
   traj.thetav = vth_samp;
   traj.cost = -1.0;
+  traj.cost_exact = true;
   traj.points.clear();
   double x = pose.x(), y = pose.y(), th = pose.z();
   double vx = vel.x(), vy = vel.y(), vth = vel.z();
   double path_dist = 0.0, goal_dist = 0.0, occ = 0.0, heading = 0.0, time = 0.0;
   // Steps whose footprint is known valid but whose outline cost was not computed (see exact_below).
   bool deferred = false;
-  const bool may_defer = table_valid_ && std::isfinite(exact_below);
+  const bool may_defer = table_valid_ && exact_below < std::numeric_limits<double>::infinity();
   for (int i = 0; i < steps; ++i) {
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
@@ -319,10 +329,12 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   traj.progress = path_bias_ * path_dist + goal_bias_ * goal_dist;
   const double rest = traj.progress + (p.heading_scoring ? 0.3 * heading : 0.0);
   traj.cost = rest + p.occdist_scale * occ;  // a lower bound while steps are deferred
+  traj.cost_exact = !deferred;
   if (deferred && traj.cost <= exact_below) {
     // It may win: the outline costs of every step, exactly.
     for (const Eigen::Vector3d& q : traj.points) occ = std::max(occ, static_cast<double>(footprintCost(map, q, footprint_, true)));
     traj.cost = rest + p.occdist_scale * occ;
+    traj.cost_exact = true;
   }
 }
 
@@ -408,32 +420,61 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   best.cost = -1.0;
   bool progressing = false;  // some valid forward trajectory ends nearer the plan and goal
   const double progress_now = progressAt(map, pose);
-  auto better = [&](const Trajectory& t) {
-    if (t.cost >= 0 && t.xv > 0 && t.progress < progress_now - 1e-9) progressing = true;
-    return t.cost >= 0 && (t.cost < best.cost || best.cost < 0);
-  };
   // Costs at or above this cannot win (the comparisons below are < best and <= best), so only the
   // trajectories that may are scored exactly.
   auto bar = [&]() { return best.cost < 0 || best.yv != 0.0 ? std::numeric_limits<double>::infinity() : best.cost; };
 
   if (!escaping_) {
+    // Every forward (and strafing) sample, validity and progress exact but the outline costs of
+    // steps over no lethal or unknown cell deferred: the cost is then a lower bound. The winner is
+    // the valid sample of least exact cost, the earliest on a tie, as a sequential scan keeping the
+    // first strict improvement would find; exact costs are computed in order of lower bound until
+    // the bound exceeds the best exact cost, usually for a handful of the samples.
+    struct Sample {
+      double vx, vy, vth, cost;
+      bool exact;
+    };
+    std::vector<Sample> samples;
+    auto consider = [&](double vx, double vy, double vth) {
+      generate(map, pose, vel, vx, vy, vth, impossible, comp, -std::numeric_limits<double>::infinity());
+      if (comp.cost < 0) return;
+      if (comp.xv > 0 && comp.progress < progress_now - 1e-9) progressing = true;
+      samples.push_back({vx, vy, vth, comp.cost, comp.cost_exact});
+    };
     double vx_samp = min_vx;
     for (int i = 0; i < p.vx_samples; ++i) {
-      generate(map, pose, vel, vx_samp, 0.0, 0.0, impossible, comp, bar());  // straight ahead, always tried
-      if (better(comp)) std::swap(best, comp);
+      consider(vx_samp, 0.0, 0.0);  // straight ahead, always tried
       double vth_samp = min_vth;
       for (int j = 0; j < p.vtheta_samples - 1; ++j) {
-        generate(map, pose, vel, vx_samp, 0.0, vth_samp, impossible, comp, bar());
-        if (better(comp)) std::swap(best, comp);
+        consider(vx_samp, 0.0, vth_samp);
         vth_samp += dvth;
       }
       vx_samp += dvx;
     }
     if (p.holonomic_robot) {
-      for (double vy : {0.1, -0.1}) {
-        generate(map, pose, vel, 0.1, vy, 0.0, impossible, comp, bar());
-        if (better(comp)) std::swap(best, comp);
+      for (double vy : {0.1, -0.1}) consider(0.1, vy, 0.0);
+    }
+    std::vector<std::size_t> order(samples.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return samples[a].cost < samples[b].cost; });
+    std::size_t winner = samples.size();
+    double winner_cost = std::numeric_limits<double>::infinity();
+    for (std::size_t k : order) {
+      Sample& c = samples[k];
+      if (c.cost > winner_cost || (c.cost == winner_cost && k > winner)) continue;  // cannot win (bound only grows)
+      if (!c.exact) {
+        generate(map, pose, vel, c.vx, c.vy, c.vth, impossible, comp);
+        c.cost = comp.cost;
+        c.exact = true;
       }
+      if (c.cost < winner_cost || (c.cost == winner_cost && k < winner)) {
+        winner = k;
+        winner_cost = c.cost;
+      }
+    }
+    if (winner < samples.size()) {
+      const Sample& c = samples[winner];
+      generate(map, pose, vel, c.vx, c.vy, c.vth, impossible, best);  // its points, and its exact cost again
     }
   }
 

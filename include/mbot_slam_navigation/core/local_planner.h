@@ -66,6 +66,7 @@ struct Trajectory {
   double xv = 0.0, yv = 0.0, thetav = 0.0;  ///< the sampled command
   double cost = -1.0;                       ///< < 0: invalid (-1 collision, -2 no path to goal)
   double progress = 0.0;                    ///< the distance terms alone at the last point
+  bool cost_exact = true;                   ///< false: `cost` is a lower bound (see generate)
   std::vector<Eigen::Vector3d> points;      ///< simulated poses (x, y, yaw)
 };
 
@@ -148,7 +149,7 @@ class LocalPlanner {
   /// circumscribed circle has a cost above 0 (the summed-area table of non-zero cells built for
   /// this cycle says so in four lookups), every outline cell is free and the cost is 0.
   /// With `defer` (may be null), a footprint whose square holds no lethal or unknown cell is valid
-  /// and its cost is left for later: *defer is set and 0 returned.
+  /// and its exact cost is left for later: *defer is set and a lower bound of it returned.
   int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer = nullptr) const;
   void buildNonZeroTable(const Costmap& map);
   void resetFlagsIfMoved(const Eigen::Vector3d& pose);
