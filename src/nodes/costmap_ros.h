@@ -9,6 +9,7 @@
 // an AsyncSpinner, the planner and controller read the grid under lock().
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -62,7 +63,8 @@ class CostmapROS {
   std::unique_ptr<core::LayeredCostmap> layered_;
   mutable std::mutex mutex_;
   std::string tf_problem_;
-  bool ever_updated_ = false, active_ = true, send_full_ = true;
+  // Set and read from several callback threads.
+  std::atomic<bool> ever_updated_{false}, active_{true}, send_full_{true};
   core::CellWindow unpublished_;
   ros::Publisher costmap_pub_, updates_pub_, footprint_pub_;
   std::vector<ros::Subscriber> subscribers_;
