@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -301,6 +302,7 @@ LayeredCostmap::LayeredCostmap(const CostmapConfig& config, Warn warn)
   }
   if (ob) {
     observations_.resize(ob->sources.size());
+    last_stamp_.assign(ob->sources.size(), std::numeric_limits<double>::quiet_NaN());
     height_warned_.assign(ob->sources.size(), false);
   }
 }
@@ -391,6 +393,7 @@ bool LayeredCostmap::addScan(std::size_t source, double stamp, const Eigen::Vect
     }
     return false;
   }
+  last_stamp_[source] = stamp;
   auto& buf = observations_[source];
   if (src.observation_persistence == 0.0) buf.clear();
   buf.push_back({stamp, sensor_pose, scan});
@@ -406,8 +409,8 @@ std::vector<std::string> LayeredCostmap::staleSources(double now) const {
   const auto& sources = config_.obstacle_layer->sources;
   for (std::size_t i = 0; i < sources.size(); ++i) {
     if (sources[i].expected_update_rate <= 0.0) continue;
-    const auto& buf = observations_[i];
-    if (buf.empty() || now - buf.back().stamp > sources[i].expected_update_rate) stale.push_back(sources[i].name);
+    // NaN (no scan yet) compares false: stale.
+    if (!(now - last_stamp_[i] <= sources[i].expected_update_rate)) stale.push_back(sources[i].name);
   }
   return stale;
 }

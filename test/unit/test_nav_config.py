@@ -253,3 +253,16 @@ def test_param_reader_types():
         r.number('a', 0.0)
     with pytest.raises(ParamError, match='/ns/b must be true or false'):
         r.boolean('b', False)
+
+
+def test_a_source_is_current_while_its_scans_keep_coming_and_stale_after_expected_update_rate():
+    """costmap_2d's isCurrent: a scan already applied still counts as the source's newest."""
+    values = {'static_map': False, 'robot_radius': 0.2, 'observation_sources': 'scan',
+              'scan': {'data_type': 'LaserScan', 'expected_update_rate': 0.5, 'clearing': True, 'marking': True}}
+    lc = LayeredCostmap(CostmapConfig('c', values, lambda w: None), print)
+    assert lc.stale_sources(1.0) == ['scan']  # no scan yet
+    assert lc.add_scan('scan', 1.0, (0.5, 0.5, 0.0), 0.1, 0.0, 0.1, 0.1, 6.0, [1.0])
+    lc.update((0.5, 0.5, 0.0))
+    lc.update((0.5, 0.5, 0.0))
+    assert lc.stale_sources(1.4) == []
+    assert lc.stale_sources(1.6) == ['scan']

@@ -112,7 +112,6 @@ class LayeredCostmap {
   void resetObstacles(const std::optional<Eigen::Vector3d>& keep = std::nullopt);
 
   const Costmap& master() const { return master_; }
-  const Costmap& obstacles() const { return obstacle_; }
   /// Index of the observation source named `name`, or -1.
   int sourceIndex(const std::string& name) const;
 
@@ -132,11 +131,11 @@ class LayeredCostmap {
   uint8_t obstacle_default_, default_value_;
   Costmap static_, obstacle_, base_, master_;  // base_: the layers composed, before inflation
   bool static_valid_ = false, map_received_ = false;
-  std::vector<std::vector<Observation>> observations_;
+  std::vector<std::vector<Observation>> observations_;  // not applied yet, or kept by observation_persistence
+  std::vector<double> last_stamp_;                       // [s] per source, the newest scan's; NaN before any
   std::vector<bool> height_warned_;
   CellWindow dirty_;        // cells whose layers changed since the last update
   bool full_ = true;        // the whole grid must be recomposed
-  std::optional<Eigen::Vector3d> last_footprint_pose_;
 };
 
 }  // namespace core
