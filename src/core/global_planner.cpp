@@ -81,9 +81,12 @@ class HeapQueue {
 };
 
 // The quadratic potential grows by at least 0.704 * cost per 4-connected step (navfn's update with
-// equal neighbours), and a displacement of k cells takes at least k such steps: the coarse bound
-// times this is a lower bound of the potential still to come.
+// equal neighbours), and a displacement takes at least its octile length in such steps: the octile
+// bound times this is a lower bound of the potential still to come.
 constexpr float kPotentialBoundScale = 0.70f;
+
+// The octile distance of an offset (|dx|, |dy|) in steps: the shortest 8-connected path on a free grid.
+float octile(int ax, int ay) { return std::max(ax, ay) + (std::sqrt(2.0f) - 1.0f) * std::min(ax, ay); }
 }  // namespace
 
 const char* toString(PlanStatus s) {
@@ -252,8 +255,7 @@ bool GlobalPlanner::coarsePlan(int start, int goal, Plan& plan) {
   const int gbx = coarse_goal_ % bw_, gby = coarse_goal_ / bw_;
   const float neutral = static_cast<float>(params_.neutral_cost) * kBlock;
   auto heuristic = [&](int b) {
-    const int ax = std::abs(b % bw_ - gbx), ay = std::abs(b / bw_ - gby);
-    return neutral * (std::max(ax, ay) + (std::sqrt(2.0f) - 1.0f) * std::min(ax, ay));
+    return neutral * octile(std::abs(b % bw_ - gbx), std::abs(b / bw_ - gby));
   };
   // block_done_: 0 unseen, 1 open, 2 closed; reset by blockCost when it first sees a block in a search.
   // Keys grow by at most two steps' cost (a consistent heuristic changes by at most one step).
@@ -365,8 +367,7 @@ bool GlobalPlanner::search(const Costmap& map, int start, int goal, Plan& plan) 
   const float neutral = static_cast<float>(params_.neutral_cost);
   auto bound = [&](int i) {
     if (!params_.use_bounds) return 0.0f;
-    const int ax = std::abs(i % w - sx), ay = std::abs(i / w - sy);
-    return kPotentialBoundScale * neutral * (std::max(ax, ay) + (std::sqrt(2.0f) - 1.0f) * std::min(ax, ay));
+    return kPotentialBoundScale * neutral * octile(std::abs(i % w - sx), std::abs(i / w - sy));
   };
   Queue open(1.0f, 2.0f * std::sqrt(2.0f) * cost::kInscribed);
   setValue(goal, 0.0f);
@@ -443,8 +444,7 @@ bool GlobalPlanner::searchAStar(const Costmap& map, int start, int goal, Plan& p
   // neutral_cost).
   auto heuristic = [&](int i) {
     const int ax = std::abs(i % w - gx), ay = std::abs(i / w - gy);
-    return params_.use_bounds ? neutral * (std::max(ax, ay) + (std::sqrt(2.0f) - 1.0f) * std::min(ax, ay))
-                              : neutral * std::hypot(float(ax), float(ay));
+    return params_.use_bounds ? neutral * octile(ax, ay) : neutral * std::hypot(float(ax), float(ay));
   };
   auto isDone = [&](int i) { return stamp_[i] == generation_ && done_[i]; };
   Queue open(1.0f, 2.0f * std::sqrt(2.0f) * cost::kInscribed);

@@ -36,8 +36,9 @@ CellWindow CellWindow::grown(int cells, int width, int height) const {
 namespace {
 
 // Inflation of `src`'s lethal cells into `dst` over `win`, reading `src` over `win` grown by the
-// radius. src and dst may be the same grid only when win covers it whole (the lethal cells are
-// read before any cell is raised, and raising never makes a cell lethal).
+// radius. src and dst may be the same grid (inflate() goes window by window in place): outside the
+// window only which cells are lethal is read, raising a cell never makes it lethal, and each
+// window cell's own value is read just before it is written.
 void inflateInto(const Costmap& src, Costmap& dst, const CellWindow& win, const InflationParams& params) {
   params.validate();
   if (win.empty()) return;

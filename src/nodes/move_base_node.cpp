@@ -336,7 +336,7 @@ class MoveBase {
     }
     auto goal = accept(action_goal->target_pose);
     if (!goal) return;
-    reset(*goal);
+    reset();
     SimRate rate(config_.controller_frequency);
     while (ros::ok()) {
       if (server_.isPreemptRequested()) {
@@ -347,7 +347,7 @@ class MoveBase {
             stop();
             break;
           }
-          reset(*goal);
+          reset();
         } else {
           stop();
           controller_->reset();
@@ -367,9 +367,8 @@ class MoveBase {
     if (server_.isActive()) server_.setAborted(move_base_msgs::MoveBaseResult(), "move_base is shutting down");
   }
 
-  void reset(const Vec3& goal) {
+  void reset() {
     const ros::Time now = ros::Time::now();
-    goal_ = goal;
     state_ = State::kPlanning;
     plan_.clear();
     new_plan_ = false;
@@ -669,7 +668,6 @@ class MoveBase {
   ros::Subscriber odom_sub_, simple_goal_sub_;
   ros::ServiceServer make_plan_srv_, clear_srv_;
   // The goal's state (the action thread only).
-  Vec3 goal_ = Vec3::Zero();
   State state_ = State::kPlanning;
   Path2 plan_;
   bool new_plan_ = false;

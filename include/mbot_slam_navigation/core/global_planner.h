@@ -7,8 +7,9 @@
 //   (the potential at a cell interpolates between its two smallest 4-neighbours, approximating the
 //   continuous distance field), stopped once the start is reached; the path descends the potential
 //   from the start, to the neighbour (8-connected) of lowest potential.
-// - A* (use_astar true): 8-connected search from the start with the euclidean distance times
-//   neutral_cost as heuristic (admissible: no cell costs less).
+// - A* (use_astar true): 8-connected search from the start with the octile distance times
+//   neutral_cost as heuristic (consistent: no cell costs less; the euclidean one with use_bounds
+//   false).
 // With use_bounds (the default), a plan is hierarchical: an A* over blocks of kBlock x kBlock cells
 // (a block costs the mean of its traversable cells; blocks with none are obstacles; neighbours are
 // connected where a fine step crosses their common edge, so any wall at least kBlock - 1 cells
