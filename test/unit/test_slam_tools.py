@@ -128,3 +128,41 @@ def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
     assert p.match_sigma == GRAPH_DEFAULTS['match_sigma'] and not p.background
     with pytest.raises(ValueError, match='loop_min_response'):
         make_graph_params({'loop_min_response': 2.0})
+
+
+def test_a_carmen_log_becomes_a_bag_that_slam_can_play(tmp_path):
+    """The bag of a log: per scan, /tf odom -> base_link -> laser at the scan's stamp, then /scan,
+    with the log's readings above range_max left as they are (out of range, REP 117)."""
+    import rosbag
+    from mbot_slam_navigation.slam.bags import write_scan_bag
+    from mbot_slam_navigation.transforms import quaternion_to_yaw
+    scans = read_log(os.path.join(DATA, 'tiny.clf'))
+    path = str(tmp_path / 'tiny.bag')
+    assert write_scan_bag(scans, path) == 3
+    assert not os.path.exists(path + '.part')
+    with rosbag.Bag(path) as bag:
+        msgs = list(bag.read_messages())
+    assert [m.topic for m in msgs] == ['/tf', '/scan'] * 3
+    tf, scan = msgs[2].message, msgs[3].message  # the second scan
+    odom, laser = tf.transforms
+    assert (odom.header.frame_id, odom.child_frame_id, laser.header.frame_id, laser.child_frame_id) == (
+        'odom', 'base_link', 'base_link', 'laser')
+    q = odom.transform.rotation
+    assert (odom.transform.translation.x, odom.transform.translation.y) == pytest.approx(scans[1].odom[:2])
+    assert quaternion_to_yaw(q.x, q.y, q.z, q.w) == pytest.approx(scans[1].odom[2])
+    assert laser.transform.translation.y == pytest.approx(scans[1].laser_pose[1], abs=1e-6)
+    assert scan.header.stamp.to_sec() == pytest.approx(scans[1].time) and odom.header.stamp == scan.header.stamp
+    assert scan.header.frame_id == 'laser' and scan.range_max == 80.0
+    assert len(scan.ranges) == 5 and scan.angle_max == pytest.approx(math.pi / 2)
+    first = msgs[1].message
+    assert first.ranges[2] == pytest.approx(81.91)  # above range_max: no return, as the log meant
+
+
+def test_jumps_of_a_published_transform():
+    from mbot_slam_navigation.slam.bags import corrections_above, largest_jump
+    pubs = np.array([(0.0, 0.0, 0.0, 0.0), (0.1, 0.01, 0.0, 0.0), (0.2, 0.31, 0.4, 3.1), (0.3, 0.31, 0.4, -3.1)])
+    move, turn, when = largest_jump(pubs)
+    assert move == pytest.approx(0.5) and when == pytest.approx(0.2)
+    assert turn == pytest.approx(3.1)  # 0 -> 3.1 rad; 3.1 -> -3.1 is 0.08 rad the short way
+    assert corrections_above(pubs, 0.1) == [(pytest.approx(0.2), pytest.approx(0.5))]
+    assert largest_jump(pubs[:1])[0] == 0.0 and corrections_above(pubs[:1], 0.1) == []

@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""SLAM as a robot runs it: each Radish log with relations played as a bag through the
+slam_gmapping node, scored on the pose the node publishes.
+
+Per log (ACES, FR079; ../shared/data/radish) and backend (graph, rbpf with 30 particles), as a
+user runs it: the log is written as a bag (`/scan`, `/tf` odom -> base_link -> laser; cached in
+bench/out/), one roscore, `rosrun mbot_slam_navigation slam_gmapping _backend:=B` and
+`rosbag play --clock -r RATE`. Recorded: every `map -> odom` the node publishes on /tf; after the
+play, `map -> base_link` looked up (tf2) at every scan's stamp. Printed: the relations error of
+those poses (Kümmerle et al., as bench_slam.py), the largest jump of `map -> odom` between
+consecutive publications and the number of corrections above 0.1 m, the node's CPU seconds (from
+/proc: every thread, the optimizer's and the tf loop's included), and beside them the same
+backend run offline on the same scans in this process (the trajectory it holds at the end, its
+CPU seconds).
+
+Environment: SLAM_NODE_LOGS (default aces,fr079), SLAM_BACKENDS (default graph,rbpf),
+SLAM_NODE_RATE (playback rate, default 10), SLAM_NODE_OFFLINE=0 to skip the offline runs.
+Targets (issue 21): online translation error <= 0.05 m (graph), <= 0.068 m (rbpf, gmapping's ACES
+figure); node CPU <= 1.2x offline. Run inside the devel environment (make bench does that).
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+from mbot_slam_navigation.slam.bags import corrections_above, largest_jump, write_scan_bag
+from mbot_slam_navigation.slam.carmen import read_log
+from mbot_slam_navigation.slam.offline import estimated_poses, run
+from mbot_slam_navigation.slam.relations import evaluate, read_relations
+from mbot_slam_navigation.transforms import quaternion_to_yaw
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.environ.get('RADISH_DIR', os.path.join(HERE, '..', '..', 'shared', 'data', 'radish'))
+OUT = os.path.join(HERE, 'out')
+PORT = 11397
+LOGS = {'aces': ('aces.clf.bz2', 'aces.relations'), 'fr079': ('fr079.clf.bz2', 'fr079.relations')}
+TARGETS = {'graph': 0.05, 'rbpf': 0.068}
+MAX_CPU_RATIO = 1.2
+
+
+def emit(**fields):
+    print(json.dumps(dict(benchmark='slam node', **fields)), flush=True)
+
+
+def node_cpu(pid):
+    """CPU seconds (user + system, every thread) of a live process, from /proc."""
+    with open('/proc/%d/stat' % pid) as f:
+        fields = f.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+class Recorder:
+    """Keeps every /tf of one run in a tf2 buffer and the map -> odom publications in order."""
+
+    def __init__(self):
+        import rospy
+        import tf2_ros
+        from std_msgs.msg import Header
+        from tf2_msgs.msg import TFMessage
+        self.lock = threading.Lock()
+        self.reset(1.0)
+        rospy.Subscriber('/tf', TFMessage, self.on_tf, queue_size=10000, tcp_nodelay=True)
+        rospy.Subscriber('/sim_heartbeat', Header, self.on_beat, queue_size=100)
+        self._tf2 = tf2_ros
+
+    def reset(self, cache_s):
+        import rospy
+        import tf2_ros
+        with self.lock:
+            self.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(cache_s), debug=False)
+            self.map_odom = []
+            self.beat = 0.0
+
+    def on_tf(self, msg):
+        with self.lock:
+            for t in msg.transforms:
+                try:
+                    self.buffer.set_transform(t, 'bench')
+                except Exception:  # noqa: BLE001 - an old stamp after a restart; not ours to judge
+                    pass
+                if t.child_frame_id == 'odom' and t.header.frame_id == 'map':
+                    r = t.transform.rotation
+                    self.map_odom.append((t.header.stamp.to_sec(), t.transform.translation.x,
+                                          t.transform.translation.y, quaternion_to_yaw(r.x, r.y, r.z, r.w)))
+
+    def on_beat(self, msg):
+        with self.lock:
+            self.beat = max(self.beat, msg.stamp.to_sec())
+
+    def poses_at(self, times):
+        import rospy
+        out, missing = [], 0
+        with self.lock:
+            for t in times:
+                try:
+                    tr = self.buffer.lookup_transform('map', 'base_link', rospy.Time.from_sec(t))
+                except Exception:  # noqa: BLE001 - before the first map -> odom, or past the last
+                    missing += 1
+                    continue
+                r = tr.transform.rotation
+                out.append((t, tr.transform.translation.x, tr.transform.translation.y,
+                            quaternion_to_yaw(r.x, r.y, r.z, r.w)))
+        return np.array(out), missing
+
+
+def play(name, bag, scans, backend, rate, recorder, env):
+    duration = scans[-1].time - scans[0].time
+    recorder.reset(duration + 60.0)
+    log = open(os.path.join(OUT, 'slam_node_%s_%s.log' % (name, backend)), 'w')
+    node = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=slam_gmapping',
+                             '_backend:=' + backend], env=env, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        time.sleep(2.0)  # the node subscribes before the first scan
+        t0 = time.time()
+        player = subprocess.run(['rosbag', 'play', '--clock', '-q', '-r', str(rate), bag], env=env, stdout=log,
+                                stderr=subprocess.STDOUT, timeout=duration / rate * 3 + 120)
+        if player.returncode != 0:
+            raise RuntimeError('rosbag play failed (exit %d); see %s' % (player.returncode, log.name))
+        # The node may still be working on the last scans: wait until its heartbeat reaches them.
+        deadline = time.time() + 60.0
+        while recorder.beat < scans[-1].time - 1e-3 and time.time() < deadline:
+            time.sleep(0.2)
+        lag = scans[-1].time - recorder.beat
+        wall = time.time() - t0
+        cpu = node_cpu(node.pid)
+    finally:
+        node.send_signal(signal.SIGINT)
+        try:
+            node.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            node.kill()
+        log.close()
+    poses, missing = recorder.poses_at([s.time for s in scans])
+    return poses, missing, np.array(recorder.map_odom), cpu, wall, lag
+
+
+def main():
+    if not os.path.isdir(DATA):
+        print('no Radish data at %s (set RADISH_DIR)' % DATA)
+        return 1
+    os.makedirs(OUT, exist_ok=True)
+    logs = os.environ.get('SLAM_NODE_LOGS', 'aces,fr079').split(',')
+    backends = os.environ.get('SLAM_BACKENDS', 'graph,rbpf').split(',')
+    rate = float(os.environ.get('SLAM_NODE_RATE', '10'))
+    offline = os.environ.get('SLAM_NODE_OFFLINE', '1') != '0'
+    env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % PORT)
+    os.environ['ROS_MASTER_URI'] = env['ROS_MASTER_URI']
+    core = subprocess.Popen(['roscore', '-p', str(PORT)], env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        import rosgraph
+        import rospy
+        deadline = time.time() + 30.0
+        while not rosgraph.is_master_online():
+            if time.time() > deadline:
+                raise RuntimeError('roscore on port %d did not start within 30 s' % PORT)
+            time.sleep(0.2)
+        rospy.init_node('bench_slam_node', anonymous=True, disable_signals=True)
+        rospy.set_param('/use_sim_time', True)  # after init: the recorder itself keeps wall time
+        recorder = Recorder()
+        for name in logs:
+            log, rel = LOGS[name]
+            scans = read_log(os.path.join(DATA, log))
+            relations = read_relations(os.path.join(DATA, rel))
+            bag = os.path.join(OUT, '%s.bag' % name)
+            if not os.path.exists(bag):
+                write_scan_bag(scans, bag)
+            times = np.array([s.time for s in scans])
+            for backend in backends:
+                poses, missing, pubs, cpu, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
+                e = evaluate(poses[:, 0], poses[:, 1:4], relations)
+                jump, turn, when = largest_jump(pubs)
+                big = corrections_above(pubs, 0.1)
+                print('%s %s through the node at %gx: %d of %d scans have a pose (%d relations skipped), '
+                      '%.0f s wall, node %.2f s behind at the end; %d map -> odom publications, %d corrections '
+                      'above 0.1 m, largest %.3f m at %.1f s' % (name, backend, rate, len(poses), len(scans), e.skipped,
+                                                                   wall, lag, len(pubs), len(big), jump, when), flush=True)
+                line = dict(note='std %.3f m, %d relations, rotation %.3f deg' % (e.trans_std, e.count, e.rot_mean))
+                if offline:
+                    slam, off_cpu = run(scans, {}, progress=False, backend=backend)
+                    off = evaluate(times, estimated_poses(slam, scans), relations)
+                    del slam
+                    line['note'] += '; offline %.4f m' % off.trans_mean
+                emit(metric='%s %s online translation error' % (name, backend), value=e.trans_mean, unit='m',
+                     target='<= %.3f' % TARGETS[backend], **line)
+                emit(metric='%s %s largest map->odom jump' % (name, backend), value=jump, unit='m',
+                     note='%.2f deg largest turn; %d corrections above 0.1 m' % (np.degrees(turn), len(big)))
+                cpu_line = dict(metric='%s %s node CPU' % (name, backend), value=cpu, unit='s')
+                if offline:
+                    cpu_line.update(target='<= %.1fx offline' % MAX_CPU_RATIO,
+                                    note='offline %.1f s: %.2fx' % (off_cpu, cpu / max(off_cpu, 1e-9)))
+                emit(**cpu_line)
+    finally:
+        core.send_signal(signal.SIGINT)
+        try:
+            core.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            core.kill()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
