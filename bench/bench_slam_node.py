@@ -8,7 +8,8 @@ bench/out/), one roscore, `rosrun mbot_slam_navigation slam_gmapping _backend:=B
 `rosbag play --clock -r RATE`. Recorded: every `map -> odom` the node publishes on /tf; after the
 play, `map -> base_link` looked up (tf2) at every scan's stamp. Printed: the relations error of
 those poses (Kümmerle et al., as bench_slam.py), the largest jump of `map -> odom` between
-consecutive publications and the number of corrections above 0.1 m, the node's CPU seconds (from
+consecutive publications, measured at the robot (the pose it implies at the odometry of its
+time) and the number of such corrections above 0.1 m, the node's CPU seconds (from
 /proc: every thread, the optimizer's and the tf loop's included), and beside them the same
 backend run offline on the same scans in this process (the trajectory it holds at the end, its
 CPU seconds).
@@ -28,7 +29,7 @@ import time
 
 import numpy as np
 
-from mbot_slam_navigation.slam.bags import corrections_above, largest_jump, write_scan_bag
+from mbot_slam_navigation.slam.bags import corrections_at_robot, write_scan_bag
 from mbot_slam_navigation.slam.carmen import read_log
 from mbot_slam_navigation.slam.offline import estimated_poses, run
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
@@ -47,11 +48,27 @@ def emit(**fields):
     print(json.dumps(dict(benchmark='slam node', **fields)), flush=True)
 
 
-def node_cpu(pid):
-    """CPU seconds (user + system, every thread) of a live process, from /proc."""
-    with open('/proc/%d/stat' % pid) as f:
+def cpu_of(stat_path):
+    """CPU seconds (user + system) in a /proc stat file."""
+    with open(stat_path) as f:
         fields = f.read().rsplit(')', 1)[1].split()
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def node_cpu(pid):
+    """(CPU seconds of a live process, every thread; {thread name: CPU seconds}) from /proc.
+    The node names its threads: slam_gmapping (the callbacks: tracking, map publication; also roscpp's own threads),
+    slam_closures (the graph's loop closure and optimizer), slam_tf (the map -> odom broadcast);
+    the rest are roscpp's and tf2's."""
+    threads = {}
+    for tid in os.listdir('/proc/%d/task' % pid):
+        try:
+            with open('/proc/%d/task/%s/comm' % (pid, tid)) as f:
+                name = f.read().strip()
+            threads[name] = threads.get(name, 0.0) + cpu_of('/proc/%d/task/%s/stat' % (pid, tid))
+        except OSError:  # the thread ended meanwhile
+            pass
+    return cpu_of('/proc/%d/stat' % pid), threads
 
 
 class Recorder:
@@ -60,12 +77,14 @@ class Recorder:
     def __init__(self):
         import rospy
         import tf2_ros
+        from geometry_msgs.msg import TransformStamped
         from std_msgs.msg import Header
         from tf2_msgs.msg import TFMessage
         self.lock = threading.Lock()
         self.reset(1.0)
         rospy.Subscriber('/tf', TFMessage, self.on_tf, queue_size=10000, tcp_nodelay=True)
         rospy.Subscriber('/sim_heartbeat', Header, self.on_beat, queue_size=100)
+        rospy.Subscriber('/slam_gmapping/correction', TransformStamped, self.on_correction, queue_size=100)
         self._tf2 = tf2_ros
 
     def reset(self, cache_s):
@@ -75,6 +94,7 @@ class Recorder:
             self.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(cache_s), debug=False)
             self.map_odom = []
             self.beat = 0.0
+            self.corrections = 0
 
     def on_tf(self, msg):
         with self.lock:
@@ -87,6 +107,10 @@ class Recorder:
                     r = t.transform.rotation
                     self.map_odom.append((t.header.stamp.to_sec(), t.transform.translation.x,
                                           t.transform.translation.y, quaternion_to_yaw(r.x, r.y, r.z, r.w)))
+
+    def on_correction(self, msg):
+        with self.lock:
+            self.corrections += 1
 
     def on_beat(self, msg):
         with self.lock:
@@ -121,13 +145,16 @@ def play(name, bag, scans, backend, rate, recorder, env):
                                 stderr=subprocess.STDOUT, timeout=duration / rate * 3 + 120)
         if player.returncode != 0:
             raise RuntimeError('rosbag play failed (exit %d); see %s' % (player.returncode, log.name))
-        # The node may still be working on the last scans: wait until its heartbeat reaches them.
-        deadline = time.time() + 60.0
-        while recorder.beat < scans[-1].time - 1e-3 and time.time() < deadline:
+        # The node may still be working on the last scans: wait until its heartbeat reaches them,
+        # or stops moving (a last scan dropped from a full queue), 60 s at most.
+        deadline, seen, still = time.time() + 60.0, -1.0, time.time()
+        while recorder.beat < scans[-1].time - 1e-3 and time.time() < deadline and time.time() - still < 3.0:
+            if recorder.beat != seen:
+                seen, still = recorder.beat, time.time()
             time.sleep(0.2)
         lag = scans[-1].time - recorder.beat
         wall = time.time() - t0
-        cpu = node_cpu(node.pid)
+        cpu, threads = node_cpu(node.pid)
     finally:
         node.send_signal(signal.SIGINT)
         try:
@@ -136,7 +163,7 @@ def play(name, bag, scans, backend, rate, recorder, env):
             node.kill()
         log.close()
     poses, missing = recorder.poses_at([s.time for s in scans])
-    return poses, missing, np.array(recorder.map_odom), cpu, wall, lag
+    return poses, missing, np.array(recorder.map_odom), recorder.corrections, cpu, threads, wall, lag
 
 
 def main():
@@ -172,14 +199,20 @@ def main():
                 write_scan_bag(scans, bag)
             times = np.array([s.time for s in scans])
             for backend in backends:
-                poses, missing, pubs, cpu, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
+                poses, missing, pubs, reported, cpu, threads, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
                 e = evaluate(poses[:, 0], poses[:, 1:4], relations)
-                jump, turn, when = largest_jump(pubs)
-                big = corrections_above(pubs, 0.1)
+                np.savetxt(os.path.join(OUT, 'slam_node_%s_%s.traj' % (name, backend)), poses, fmt='%.6f',
+                           header='t x y theta: map -> base_link at each scan stamp, as published')
+                moves = corrections_at_robot(pubs, times, np.array([s.odom for s in scans]))
+                big = moves[moves[:, 1] > 0.1]
+                worst = int(np.argmax(moves[:, 1])) if len(moves) else None
+                jump, when = (moves[worst, 1], moves[worst, 0]) if worst is not None else (0.0, float('nan'))
+                turn = moves[:, 2].max() if len(moves) else 0.0
                 print('%s %s through the node at %gx: %d of %d scans have a pose (%d relations skipped), '
-                      '%.0f s wall, node %.2f s behind at the end; %d map -> odom publications, %d corrections '
-                      'above 0.1 m, largest %.3f m at %.1f s' % (name, backend, rate, len(poses), len(scans), e.skipped,
-                                                                   wall, lag, len(pubs), len(big), jump, when), flush=True)
+                      '%.0f s wall, node %.2f s behind at the end; %d map -> odom publications; the robot '
+                      'moved by %d corrections above 0.1 m, the largest %.3f m at %.1f s; %d on ~correction' % (
+                          name, backend, rate, len(poses), len(scans), e.skipped, wall, lag, len(pubs), len(big), jump,
+                          when, reported), flush=True)
                 line = dict(note='std %.3f m, %d relations, rotation %.3f deg' % (e.trans_std, e.count, e.rot_mean))
                 if offline:
                     slam, off_cpu = run(scans, {}, progress=False, backend=backend)
@@ -188,8 +221,10 @@ def main():
                     line['note'] += '; offline %.4f m' % off.trans_mean
                 emit(metric='%s %s online translation error' % (name, backend), value=e.trans_mean, unit='m',
                      target='<= %.3f' % TARGETS[backend], **line)
-                emit(metric='%s %s largest map->odom jump' % (name, backend), value=jump, unit='m',
+                emit(metric='%s %s largest correction at the robot' % (name, backend), value=jump, unit='m',
                      note='%.2f deg largest turn; %d corrections above 0.1 m' % (np.degrees(turn), len(big)))
+                print('%s %s node CPU by thread: %s' % (name, backend, ', '.join(
+                    '%s %.1f s' % kv for kv in sorted(threads.items(), key=lambda kv: -kv[1]))), flush=True)
                 cpu_line = dict(metric='%s %s node CPU' % (name, backend), value=cpu, unit='s')
                 if offline:
                     cpu_line.update(target='<= %.1fx offline' % MAX_CPU_RATIO,

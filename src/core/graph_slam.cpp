@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#ifdef __linux__
+#include <pthread.h>
+#endif
+
 #include "mbot_slam_navigation/core/pose2d.h"
 
 namespace mbot {
@@ -56,7 +60,12 @@ GraphSlam::GraphSlam(const GraphSlamParams& params)
     : params_((params.validate(), params)),
       registrar_(params.matcher, params.delta),
       map_({params.xmin, params.ymin}, {params.xmax, params.ymax}, params.delta) {
-  if (params_.background) worker_ = std::thread([this] { backgroundLoop(); });
+  if (params_.background) {
+    worker_ = std::thread([this] { backgroundLoop(); });
+#ifdef __linux__
+    pthread_setname_np(worker_.native_handle(), "slam_closures");  // for top -H and /proc
+#endif
+  }
 }
 
 GraphSlam::~GraphSlam() {

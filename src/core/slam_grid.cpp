@@ -98,10 +98,19 @@ OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
   img.height = (py1 - py0 + 1) * kPatchSize;
   img.origin = origin_ + Eigen::Vector2d(px0, py0) * kPatchSize * resolution_;
   img.data.assign(static_cast<std::size_t>(img.width) * img.height, -1);
-  for (int y = 0; y < img.height; ++y) {
-    for (int x = 0; x < img.width; ++x) {
-      const double occ = cell({x + px0 * kPatchSize, y + py0 * kPatchSize}).occupancy();
-      if (occ >= 0.0) img.data[static_cast<std::size_t>(y) * img.width + x] = occ > occ_thresh ? 100 : 0;
+  // Patch by patch: cells of absent patches stay unknown without being looked up one by one.
+  for (int py = py0; py <= py1; ++py) {
+    for (int px = px0; px <= px1; ++px) {
+      const Patch* patch = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
+      if (!patch) continue;
+      for (int cy = 0; cy < kPatchSize; ++cy) {
+        int8_t* row = &img.data[static_cast<std::size_t>((py - py0) * kPatchSize + cy) * img.width + (px - px0) * kPatchSize];
+        const HitCell* cells = &patch->cells[cy << kPatchBits];
+        for (int cx = 0; cx < kPatchSize; ++cx) {
+          const double occ = cells[cx].occupancy();
+          if (occ >= 0.0) row[cx] = occ > occ_thresh ? 100 : 0;
+        }
+      }
     }
   }
   return img;

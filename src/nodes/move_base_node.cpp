@@ -40,6 +40,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "costmap_ros.h"
+#include "sim_rate.h"
 #include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/move_base_config.h"
 #include "mbot_slam_navigation/core/trajectory_controller.h"
@@ -50,6 +51,7 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 using Path2 = std::vector<Eigen::Vector2d>;
+using ros_glue::SimRate;
 enum class State { kPlanning, kControlling, kClearing };
 enum class Trigger { kNone, kPlanning, kControlling, kOscillation };
 
@@ -78,46 +80,6 @@ Vec3 compose(const Vec3& a, const Vec3& b) {
   return {a.x() + c * b.x() - s * b.y(), a.y() + s * b.x() + c * b.y(), std::atan2(std::sin(a.z() + b.z()), std::cos(a.z() + b.z()))};
 }
 
-// A fixed-rate loop like ros::Rate, but under simulated time it does not poll: roscpp's sleep
-// wakes every millisecond of wall time until /clock passes the deadline (about 14 wake-ups per
-// 10 Hz cycle at 7x real time, each a context switch). This one sleeps for the wall time the
-// remaining simulated time should take at the pace /clock has been advancing, then checks again.
-// A clock that jumps back (a reset simulation) ends the wait, as ros::Rate does.
-class SimRate {
- public:
-  explicit SimRate(double hz) : period_(1.0 / hz), next_(ros::Time::now() + period_) {}
-  void sleep() {
-    if (!ros::Time::isSimTime()) {
-      const ros::Duration left = next_ - ros::Time::now();
-      if (left > ros::Duration(0)) left.sleep();
-    } else {
-      ros::Time last = ros::Time::now();
-      ros::WallTime wall_last = ros::WallTime::now();
-      while (ros::ok() && last < next_) {
-        const double wall = std::clamp((next_ - last).toSec() / pace_.load(), 0.0005, 0.05);
-        std::this_thread::sleep_for(std::chrono::duration<double>(wall));
-        const ros::Time now = ros::Time::now();
-        const ros::WallTime wall_now = ros::WallTime::now();
-        if (now < last) break;  // the clock went back
-        const double dw = (wall_now - wall_last).toSec();
-        if (dw > 0.005 && now > last) pace_ = std::clamp((now - last).toSec() / dw, 0.05, 500.0);
-        last = now;
-        wall_last = wall_now;
-      }
-    }
-    const ros::Time now = ros::Time::now();
-    next_ += period_;
-    if (next_ < now || next_ > now + period_ * 2.0) next_ = now + period_;  // behind, or the clock jumped
-  }
-
- private:
-  ros::Duration period_;
-  ros::Time next_;
-  // Simulated seconds per wall second, as last seen (one clock for all loops). Starting high
-  // only costs a few short first waits; starting low would oversleep.
-  static std::atomic<double> pace_;
-};
-std::atomic<double> SimRate::pace_{20.0};
 
 class MoveBase {
  public:

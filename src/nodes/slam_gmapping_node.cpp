@@ -5,14 +5,20 @@
 // Subscribes `scan` (with tf from its frame to ~base_frame and from ~base_frame to ~odom_frame);
 // publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy` (rbpf only: the
 // graph has no particle cloud); serves `dynamic_map`; broadcasts ~map_frame -> ~odom_frame every
-// ~transform_publish_period. Parameters have gmapping's names and defaults, plus the graph's own
+// ~transform_publish_period (stamped ahead, as gmapping) and again after each scan that moved it,
+// stamped with that scan; publishes `~correction` (geometry_msgs/TransformStamped: how the map
+// frame moved) when a correction moves the robot by more than ~correction_threshold [m] (0.1).
+// Parameters have gmapping's names and defaults, plus the graph's own
 // (graph_slam.h); an unknown private parameter gets a warning naming the nearest known one (the
 // tutorial's `base_link` means `base_frame`).
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <thread>
+
+#include <pthread.h>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/GetMap.h>
@@ -30,11 +36,13 @@
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "ros_conversions.h"
+#include "sim_rate.h"
 
 namespace {
 
 using mbot::core::composePose;
 using mbot::core::inversePose;
+using mbot::core::relativePose;
 
 Eigen::Vector3d toPose(const geometry_msgs::TransformStamped& t) {
   return {t.transform.translation.x, t.transform.translation.y, tf2::getYaw(t.transform.rotation)};
@@ -53,11 +61,13 @@ class SlamGmappingNode {
     map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
     meta_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
     entropy_pub_ = pnh_.advertise<std_msgs::Float64>("entropy", 1, true);
+    correction_pub_ = pnh_.advertise<geometry_msgs::TransformStamped>("correction", 10);
     if (ros::Time::isSimTime()) heartbeat_pub_ = nh_.advertise<std_msgs::Header>("/sim_heartbeat", 10);
     map_srv_ = nh_.advertiseService("dynamic_map", &SlamGmappingNode::onDynamicMap, this);
     scan_sub_ = nh_.subscribe("scan", 5, &SlamGmappingNode::onScan, this);
     if (transform_publish_period_ > 0.0) {
       tf_thread_ = std::thread([this] { publishTransformLoop(); });
+      pthread_setname_np(tf_thread_.native_handle(), "slam_tf");  // for top -H and /proc
     }
   }
 
@@ -81,6 +91,7 @@ class SlamGmappingNode {
     param("occ_thresh", occ_thresh_);
     param("throttle_scans", throttle_scans_);
     param("tf_delay", tf_delay_);
+    param("correction_threshold", correction_threshold_);
     auto& p = params_;
     auto& m = p.matcher;
     double max_urange = -1.0, max_range = -1.0;  // default: the scan's range_max, as gmapping
@@ -180,6 +191,11 @@ class SlamGmappingNode {
       slam_.reset();
       tf_buffer_.clear();
       map_to_odom_.setZero();
+      std::lock_guard<std::mutex> stamps(stamp_mutex_);
+      loop_stamps_.clear();
+      scan_stamps_.clear();
+      last_scan_tf_stamp_ = ros::Time();
+      first_transform_ = true;
     }
     last_stamp_ = msg->header.stamp;
 
@@ -218,14 +234,20 @@ class SlamGmappingNode {
                params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
                base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
     }
-    bool updated;
+    bool updated, moved = false;
+    Eigen::Vector3d before, after;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
       // gmapping moves map -> odom at its updates only; the graph tracks every scan, and its
       // optimizer moves the current pose by exactly its correction, so map -> odom follows both.
-      if (updated || backend_ == "graph") map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
+      if (updated || backend_ == "graph") {
+        before = map_to_odom_;
+        after = map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
+        moved = true;
+      }
     }
+    if (moved) publishScanTransform(msg->header.stamp, before, after, odom);
     beatHeartbeat(msg->header.stamp);
     if (!updated) return;
     if (const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get())) {
@@ -237,6 +259,50 @@ class SlamGmappingNode {
       publishMap(msg->header.stamp);
       last_map_update_ = msg->header.stamp;
     }
+  }
+
+  // map -> odom as estimated from the scan at `stamp`, stamped with it, so that map -> base at the
+  // scan's time is the pose SLAM gave that scan: the periodic broadcast (stamped ahead, as gmapping)
+  // already covers that time with the estimate of the scan before. A stamp the broadcast has used
+  // is skipped: tf2 keeps the first of two transforms with one stamp and warns of the second.
+  // A change of the robot's pose above ~correction_threshold (a loop closure, another best
+  // particle) is published on ~correction and logged at debug level.
+  void publishScanTransform(const ros::Time& stamp, const Eigen::Vector3d& before, const Eigen::Vector3d& after,
+                            const Eigen::Vector3d& odom) {
+    {
+      std::lock_guard<std::mutex> lock(stamp_mutex_);
+      if (stamp <= last_scan_tf_stamp_ ||
+          std::find(loop_stamps_.begin(), loop_stamps_.end(), stamp) != loop_stamps_.end()) {
+        return;
+      }
+      last_scan_tf_stamp_ = stamp;
+      scan_stamps_.push_back(stamp);
+      if (scan_stamps_.size() > kStampMemory) scan_stamps_.pop_front();
+    }
+    broadcaster_.sendTransform(mapToOdomMsg(stamp, after));
+    // The robot's pose moved by the change of map -> odom at its current odometry.
+    const Eigen::Vector3d moved = relativePose(composePose(before, odom), composePose(after, odom));
+    const Eigen::Vector3d change = composePose(after, inversePose(before));
+    if (!first_transform_ && moved.head<2>().norm() > correction_threshold_) {
+      ROS_DEBUG("slam_gmapping: the pose of the scan at %.3f corrected by %.3f m, %.2f deg (map -> odom moved)",
+                stamp.toSec(), moved.head<2>().norm(), moved.z() * 180.0 / M_PI);
+      geometry_msgs::TransformStamped c = mapToOdomMsg(stamp, change);
+      c.child_frame_id = map_frame_;  // the map frame before the correction, in the map frame after it
+      correction_pub_.publish(c);
+    }
+    first_transform_ = false;
+  }
+
+  geometry_msgs::TransformStamped mapToOdomMsg(const ros::Time& stamp, const Eigen::Vector3d& m) const {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = stamp;
+    t.header.frame_id = map_frame_;
+    t.child_frame_id = odom_frame_;
+    t.transform.translation.x = m.x();
+    t.transform.translation.y = m.y();
+    t.transform.rotation.z = std::sin(m.z() / 2.0);
+    t.transform.rotation.w = std::cos(m.z() / 2.0);
+    return t;
   }
 
   // Tells a simulator running real_time_factor:=auto how far SLAM has got: the stamp of the scan
@@ -273,7 +339,7 @@ class SlamGmappingNode {
   }
 
   void publishTransformLoop() {
-    ros::Rate rate(1.0 / transform_publish_period_);
+    mbot::ros_glue::SimRate rate(1.0 / transform_publish_period_);  // no polling of /clock
     ros::Time last_tf_time;
     while (ros::ok()) {
       Eigen::Vector3d m;
@@ -287,16 +353,18 @@ class SlamGmappingNode {
         continue;
       }
       last_tf_time = now;
-      geometry_msgs::TransformStamped t;
       // Stamped ahead, as gmapping does, so that lookups at "now" find it.
-      t.header.stamp = now + ros::Duration(tf_delay_ > 0.0 ? tf_delay_ : transform_publish_period_);
-      t.header.frame_id = map_frame_;
-      t.child_frame_id = odom_frame_;
-      t.transform.translation.x = m.x();
-      t.transform.translation.y = m.y();
-      t.transform.rotation.z = std::sin(m.z() / 2.0);
-      t.transform.rotation.w = std::cos(m.z() / 2.0);
-      broadcaster_.sendTransform(t);
+      const ros::Time stamp = now + ros::Duration(tf_delay_ > 0.0 ? tf_delay_ : transform_publish_period_);
+      {
+        std::lock_guard<std::mutex> lock(stamp_mutex_);
+        if (std::find(scan_stamps_.begin(), scan_stamps_.end(), stamp) != scan_stamps_.end()) {
+          rate.sleep();  // a scan's estimate holds this stamp already
+          continue;
+        }
+        loop_stamps_.push_back(stamp);
+        if (loop_stamps_.size() > kStampMemory) loop_stamps_.pop_front();
+      }
+      broadcaster_.sendTransform(mapToOdomMsg(stamp, m));
       rate.sleep();
     }
   }
@@ -312,10 +380,17 @@ class SlamGmappingNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_;
+  ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_;
   ros::Subscriber scan_sub_;
   ros::ServiceServer map_srv_;
   std::mutex mutex_, map_mutex_;
+  // Stamps of map -> odom lately sent by the broadcast loop and by the scan callback (stamp_mutex_).
+  static constexpr std::size_t kStampMemory = 256;
+  std::mutex stamp_mutex_;
+  std::deque<ros::Time> loop_stamps_, scan_stamps_;
+  ros::Time last_scan_tf_stamp_;
+  bool first_transform_ = true;
+  double correction_threshold_ = 0.1;
   std::unique_ptr<mbot::core::SlamBackend> slam_;
   Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
   nav_msgs::OccupancyGrid last_map_;

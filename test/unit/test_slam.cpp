@@ -101,6 +101,30 @@ TEST(SlamGrid, GrowthKeepsOldCellsAndCopiesOnWrite) {
   EXPECT_LT(b.ownedPatches(), b.allocatedPatches() + 1);
 }
 
+TEST(SlamGrid, OccupancyImageIsEveryCellsRatioCroppedToTheWrittenPatches) {
+  SlamGrid g({0, 0}, {2, 2}, 0.05);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-2.5, 4.0);
+  for (int k = 0; k < 300; ++k) g.registerBeam({u(rng), u(rng)}, {u(rng), u(rng)}, k % 3 != 0);  // grows the grid
+  for (double thresh : {0.0, 0.25, 0.5}) {
+    const OccupancyImage img = g.toOccupancy(thresh);
+    ASSERT_GT(img.width, 0);
+    int known = 0, occupied = 0;
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x < img.width; ++x) {
+        const Eigen::Vector2d centre = img.origin + Eigen::Vector2d(x + 0.5, y + 0.5) * img.resolution;
+        const double occ = g.cell(g.worldToCell(centre)).occupancy();
+        const int expected = occ < 0.0 ? -1 : (occ > thresh ? 100 : 0);
+        ASSERT_EQ(img.data[static_cast<std::size_t>(y) * img.width + x], expected) << "cell " << x << ", " << y;
+        known += expected >= 0;
+        occupied += expected == 100;
+      }
+    }
+    EXPECT_GT(known, 1000);
+    EXPECT_GT(occupied, 50);
+  }
+}
+
 TEST(MotionModel, SampleStatisticsMatchTheParameters) {
   MotionModelParams p;
   p.srr = 0.1;

@@ -158,11 +158,19 @@ def test_a_carmen_log_becomes_a_bag_that_slam_can_play(tmp_path):
     assert first.ranges[2] == pytest.approx(81.91)  # above range_max: no return, as the log meant
 
 
-def test_jumps_of_a_published_transform():
-    from mbot_slam_navigation.slam.bags import corrections_above, largest_jump
-    pubs = np.array([(0.0, 0.0, 0.0, 0.0), (0.1, 0.01, 0.0, 0.0), (0.2, 0.31, 0.4, 3.1), (0.3, 0.31, 0.4, -3.1)])
-    move, turn, when = largest_jump(pubs)
-    assert move == pytest.approx(0.5) and when == pytest.approx(0.2)
-    assert turn == pytest.approx(3.1)  # 0 -> 3.1 rad; 3.1 -> -3.1 is 0.08 rad the short way
-    assert corrections_above(pubs, 0.1) == [(pytest.approx(0.2), pytest.approx(0.5))]
-    assert largest_jump(pubs[:1])[0] == 0.0 and corrections_above(pubs[:1], 0.1) == []
+def test_corrections_as_the_robot_sees_them():
+    """A rotation of map -> odom moves the robot by the rotation times its distance from the odom
+    origin, not by how far the odom frame's origin moved; the robot's own motion between two
+    publications is not a correction."""
+    from mbot_slam_navigation.slam.bags import corrections_at_robot
+    odom_times = np.array([0.0, 1.0, 2.0, 3.0])
+    odom = np.array([(0.0, 0.0, 0.0), (10.0, 0.0, 0.0), (20.0, 0.0, 0.0), (30.0, 0.0, 0.0)])
+    pubs = np.array([(0.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0),       # the robot drives: no correction
+                     (2.0, 0.0, 0.0, 0.01),                              # 0.01 rad at 20 m from the origin
+                     (3.0, -0.3, 0.0, 0.01)])                            # a 0.3 m shift back
+    moves = corrections_at_robot(pubs, odom_times, odom)
+    assert moves.shape == (3, 3)
+    assert moves[0, 1] == pytest.approx(0.0)
+    assert moves[1, 1] == pytest.approx(0.2, abs=0.001) and moves[1, 2] == pytest.approx(0.01)
+    assert moves[2, 1] == pytest.approx(0.3) and moves[2, 0] == 3.0
+    assert corrections_at_robot(pubs[:1], odom_times, odom).shape == (0, 3)

@@ -1,17 +1,18 @@
 """Logs as a robot's topics: a CARMEN log written as a rosbag that slam_gmapping can be run on
-with `rosbag play --clock`, and what a SLAM node published, read back as poses.
+with `rosbag play --clock`, and what a SLAM node published, measured as the robot sees it.
 
 The bag has, per scan (stamped with the log's time [s]): `/tf` with odom -> base_link (the log's
 odometry) and base_link -> laser (the laser's mounting), then `/scan` (sensor_msgs/LaserScan in the
 laser frame, range_max as given, so that the logs' "no return" readings above it are out of range
 as REP 117 says). The file is written to a temporary name and renamed, so a bag that exists is whole.
 """
+import math
 import os
 from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from mbot_slam_navigation.transforms import normalize_angle, yaw_to_quaternion
+from mbot_slam_navigation.transforms import compose2d, normalize_angle, yaw_to_quaternion
 
 
 def _transform(stamp, parent: str, child: str, pose: Sequence[float]):
@@ -50,26 +51,23 @@ def write_scan_bag(scans, path: str, range_max: float = 80.0, odom_frame: str = 
     return len(scans)
 
 
-def largest_jump(publications: np.ndarray) -> Tuple[float, float, float]:
-    """The largest change of a published transform between consecutive publications.
+def corrections_at_robot(publications: np.ndarray, odom_times: np.ndarray, odom_poses: np.ndarray) -> np.ndarray:
+    """How far each publication of map -> odom moves the robot: (N-1, 3) rows of stamp [s],
+    translation [m], |rotation| [rad], one per publication after the first.
 
-    publications: (N, 4) rows of stamp [s], x, y, yaw, in the order published. Returns
-    (translation [m], rotation [rad], stamp [s] of the larger translation jump)."""
+    publications: (N, 4) rows of stamp, x, y, yaw in the order published; odom_times/odom_poses:
+    the odometry (base in odom) over time. Both the publication and the one before it are applied
+    to the odometry at the newer one's stamp (the nearest sample), so that the robot's own motion
+    between their stamps does not count, and a rotation of map -> odom counts by how it moves the
+    robot, not by how it moves the odom frame's far-away origin."""
     p = np.asarray(publications, float)
     if len(p) < 2:
-        return 0.0, 0.0, float('nan')
-    d = np.hypot(np.diff(p[:, 1]), np.diff(p[:, 2]))
-    r = np.abs([normalize_angle(a) for a in np.diff(p[:, 3])])
-    k = int(np.argmax(d))
-    return float(d[k]), float(np.max(r)), float(p[k + 1, 0])
-
-
-def corrections_above(publications: np.ndarray, threshold: float) -> List[Tuple[float, float]]:
-    """(stamp [s], translation [m]) of every change between consecutive publications above
-    `threshold` [m]."""
-    p = np.asarray(publications, float)
-    if len(p) < 2:
-        return []
-    d = np.hypot(np.diff(p[:, 1]), np.diff(p[:, 2]))
-    return [(float(p[k + 1, 0]), float(d[k])) for k in np.flatnonzero(d > threshold)]
-
+        return np.zeros((0, 3))
+    times = np.asarray(odom_times, float)
+    k = np.clip(np.searchsorted(times, p[1:, 0]), 0, len(times) - 1)
+    out = np.zeros((len(p) - 1, 3))
+    for row, (i, j) in enumerate(zip(range(len(p) - 1), k)):
+        before, after = compose2d(p[i, 1:4], odom_poses[j]), compose2d(p[i + 1, 1:4], odom_poses[j])
+        out[row] = (p[i + 1, 0], math.hypot(after[0] - before[0], after[1] - before[1]),
+                    abs(normalize_angle(after[2] - before[2])))
+    return out
