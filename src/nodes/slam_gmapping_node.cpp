@@ -269,17 +269,21 @@ class SlamGmappingNode {
   // particle) is published on ~correction and logged at debug level.
   void publishScanTransform(const ros::Time& stamp, const Eigen::Vector3d& before, const Eigen::Vector3d& after,
                             const Eigen::Vector3d& odom) {
+    // A scan processed long after its time (a lagging node, an old bag): tf listeners keep 10 s by
+    // default and would warn of "data from the past"; the broadcast carries the estimate on.
+    const bool recent = ros::Time::now() - stamp < ros::Duration(kMaxScanTransformAge);
+    bool send;
     {
       std::lock_guard<std::mutex> lock(stamp_mutex_);
-      if (stamp <= last_scan_tf_stamp_ ||
-          std::find(loop_stamps_.begin(), loop_stamps_.end(), stamp) != loop_stamps_.end()) {
-        return;
+      send = recent && stamp > last_scan_tf_stamp_ &&
+             std::find(loop_stamps_.begin(), loop_stamps_.end(), stamp) == loop_stamps_.end();
+      if (send) {
+        last_scan_tf_stamp_ = stamp;
+        scan_stamps_.push_back(stamp);
+        if (scan_stamps_.size() > kStampMemory) scan_stamps_.pop_front();
       }
-      last_scan_tf_stamp_ = stamp;
-      scan_stamps_.push_back(stamp);
-      if (scan_stamps_.size() > kStampMemory) scan_stamps_.pop_front();
     }
-    broadcaster_.sendTransform(mapToOdomMsg(stamp, after));
+    if (send) broadcaster_.sendTransform(mapToOdomMsg(stamp, after));
     // The robot's pose moved by the change of map -> odom at its current odometry.
     const Eigen::Vector3d moved = relativePose(composePose(before, odom), composePose(after, odom));
     const Eigen::Vector3d change = composePose(after, inversePose(before));
@@ -386,6 +390,7 @@ class SlamGmappingNode {
   std::mutex mutex_, map_mutex_;
   // Stamps of map -> odom lately sent by the broadcast loop and by the scan callback (stamp_mutex_).
   static constexpr std::size_t kStampMemory = 256;
+  static constexpr double kMaxScanTransformAge = 5.0;  // [s]
   std::mutex stamp_mutex_;
   std::deque<ros::Time> loop_stamps_, scan_stamps_;
   ros::Time last_scan_tf_stamp_;
