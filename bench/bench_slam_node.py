@@ -21,7 +21,6 @@ figure); node CPU <= 1.2x offline. Run inside the devel environment (make bench 
 """
 import json
 import os
-import signal
 import subprocess
 import sys
 import threading
@@ -29,6 +28,7 @@ import time
 
 import numpy as np
 
+from mbot_slam_navigation.exploration_run import stop
 from mbot_slam_navigation.slam.bags import corrections_at_robot, write_scan_bag
 from mbot_slam_navigation.slam.carmen import read_log
 from mbot_slam_navigation.slam.offline import estimated_poses, run
@@ -156,11 +156,7 @@ def play(name, bag, scans, backend, rate, recorder, env):
         wall = time.time() - t0
         cpu, threads = node_cpu(node.pid)
     finally:
-        node.send_signal(signal.SIGINT)
-        try:
-            node.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            node.kill()
+        stop(node, grace_s=20.0)
         log.close()
     poses, missing = recorder.poses_at([s.time for s in scans])
     return poses, missing, np.array(recorder.map_odom), recorder.corrections, cpu, threads, wall, lag
@@ -231,11 +227,7 @@ def main():
                                     note='offline %.1f s: %.2fx' % (off_cpu, cpu / max(off_cpu, 1e-9)))
                 emit(**cpu_line)
     finally:
-        core.send_signal(signal.SIGINT)
-        try:
-            core.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            core.kill()
+        stop(core, grace_s=20.0)
     return 0
 
 
