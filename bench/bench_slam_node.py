@@ -12,7 +12,8 @@ consecutive publications, measured at the robot (the pose it implies at the odom
 time) and the number of such corrections above 0.1 m, the node's CPU seconds (from
 /proc: every thread, the optimizer's and the tf loop's included), and beside them the same
 backend run offline on the same scans in this process (the trajectory it holds at the end, its
-CPU seconds).
+CPU seconds). The published poses are written to bench/out/slam_node_<log>_<backend>.traj
+(`t x y theta`), the node's output to the .log beside it.
 
 Environment: SLAM_NODE_LOGS (default aces,fr079), SLAM_BACKENDS (default graph,rbpf),
 SLAM_NODE_RATE (playback rate, default 10), SLAM_NODE_OFFLINE=0 to skip the offline runs.
@@ -132,6 +133,21 @@ class Recorder:
         return np.array(out), missing
 
 
+def wait_for_subscriber(topic, proc, timeout_s):
+    """Waits until some node subscribes `topic` (the SLAM node is ready for the first scan)."""
+    import rosgraph
+    master = rosgraph.Master('/bench_slam_node')
+    deadline = time.time() + timeout_s
+    while time.time() < deadline:
+        if proc.poll() is not None:
+            raise RuntimeError('slam_gmapping ended (exit %d) before subscribing %s' % (proc.returncode, topic))
+        _, subscribers, _ = master.getSystemState()
+        if any(name == topic and nodes for name, nodes in subscribers):
+            return
+        time.sleep(0.2)
+    raise RuntimeError('nothing subscribed %s within %.0f s: did slam_gmapping start?' % (topic, timeout_s))
+
+
 def play(name, bag, scans, backend, rate, recorder, env):
     duration = scans[-1].time - scans[0].time
     recorder.reset(duration + 60.0)
@@ -139,7 +155,7 @@ def play(name, bag, scans, backend, rate, recorder, env):
     node = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=slam_gmapping',
                              '_backend:=' + backend], env=env, stdout=log, stderr=subprocess.STDOUT)
     try:
-        time.sleep(2.0)  # the node subscribes before the first scan
+        wait_for_subscriber('/scan', node, timeout_s=30.0)
         t0 = time.time()
         player = subprocess.run(['rosbag', 'play', '--clock', '-q', '-r', str(rate), bag], env=env, stdout=log,
                                 stderr=subprocess.STDOUT, timeout=duration / rate * 3 + 120)
