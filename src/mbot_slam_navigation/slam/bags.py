@@ -8,7 +8,7 @@ as REP 117 says). The file is written to a temporary name and renamed, so a bag 
 """
 import math
 import os
-from typing import List, Sequence, Tuple
+from typing import Sequence
 
 import numpy as np
 
