@@ -77,7 +77,6 @@ class Recorder:
 
     def __init__(self):
         import rospy
-        import tf2_ros
         from geometry_msgs.msg import TransformStamped
         from std_msgs.msg import Header
         from tf2_msgs.msg import TFMessage
@@ -86,7 +85,6 @@ class Recorder:
         rospy.Subscriber('/tf', TFMessage, self.on_tf, queue_size=10000, tcp_nodelay=True)
         rospy.Subscriber('/sim_heartbeat', Header, self.on_beat, queue_size=100)
         rospy.Subscriber('/slam_gmapping/correction', TransformStamped, self.on_correction, queue_size=100)
-        self._tf2 = tf2_ros
 
     def reset(self, cache_s):
         import rospy
@@ -119,18 +117,17 @@ class Recorder:
 
     def poses_at(self, times):
         import rospy
-        out, missing = [], 0
+        out = []
         with self.lock:
             for t in times:
                 try:
                     tr = self.buffer.lookup_transform('map', 'base_link', rospy.Time.from_sec(t))
                 except Exception:  # noqa: BLE001 - before the first map -> odom, or past the last
-                    missing += 1
                     continue
                 r = tr.transform.rotation
                 out.append((t, tr.transform.translation.x, tr.transform.translation.y,
                             quaternion_to_yaw(r.x, r.y, r.z, r.w)))
-        return np.array(out), missing
+        return np.array(out)
 
 
 def wait_for_subscriber(topic, proc, timeout_s):
@@ -174,8 +171,8 @@ def play(name, bag, scans, backend, rate, recorder, env):
     finally:
         stop(node, grace_s=20.0)
         log.close()
-    poses, missing = recorder.poses_at([s.time for s in scans])
-    return poses, missing, np.array(recorder.map_odom), recorder.corrections, cpu, threads, wall, lag
+    poses = recorder.poses_at([s.time for s in scans])
+    return poses, np.array(recorder.map_odom), recorder.corrections, cpu, threads, wall, lag
 
 
 def main():
@@ -211,7 +208,7 @@ def main():
                 write_scan_bag(scans, bag)
             times = np.array([s.time for s in scans])
             for backend in backends:
-                poses, missing, pubs, reported, cpu, threads, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
+                poses, pubs, reported, cpu, threads, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
                 e = evaluate(poses[:, 0], poses[:, 1:4], relations)
                 np.savetxt(os.path.join(OUT, 'slam_node_%s_%s.traj' % (name, backend)), poses, fmt='%.6f',
                            header='t x y theta: map -> base_link at each scan stamp, as published')
