@@ -243,6 +243,9 @@ PYBIND11_MODULE(_core, m) {
       py::arg("grid"), py::arg("origin"), py::arg("angles"), py::arg("max_range"),
       py::arg("occupied_probability") = 0.5);
 
+  m.def("_point_polygon_distance", &mbot::core::pointPolygonDistance, py::arg("point"), py::arg("polygon"),
+        "Distance [m] from a point to a solid polygon (0 inside).");
+
   py::class_<World2D>(m, "_World2D")
       .def(py::init<double>(), py::arg("bucket_size") = 0.5)
       .def("add_box", &World2D::addBox, py::arg("center"), py::arg("yaw"), py::arg("size_x"), py::arg("size_y"))
@@ -250,6 +253,8 @@ PYBIND11_MODULE(_core, m) {
       .def("add_cylinder", &World2D::addCylinder, py::arg("center"), py::arg("radius"))
       .def("add_segment", &World2D::addSegment, py::arg("a"), py::arg("b"))
       .def("set_dynamic_polygons", &World2D::setDynamicPolygons, py::arg("polygons"))
+      .def("set_dynamic_circles", &World2D::setDynamicCircles, py::arg("circles"))
+      .def("distance_to_dynamic_polygons", &World2D::distanceToDynamicPolygons, py::arg("point"))
       .def("cast_ray", &World2D::castRay, py::arg("origin"), py::arg("angle"), py::arg("max_range"),
            py::arg("skip_dynamic") = -1)
       .def("overlaps", &World2D::overlaps, py::arg("polygon"), py::arg("skip_dynamic") = -1)

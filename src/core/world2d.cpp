@@ -82,7 +82,31 @@ double rayPolygon(const Eigen::Vector2d& p, const Eigen::Vector2d& d, const Poly
   return best;
 }
 
+bool polygonTouchesCircle(const Polygon& polygon, const Eigen::Vector2d& c, double r) {
+  if (pointInPolygon(c, polygon)) return true;
+  for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
+    if (pointSegmentDistance(c, polygon[b], polygon[a]) < r) return true;
+  }
+  return false;
+}
+
 }  // namespace
+
+double pointPolygonDistance(const Eigen::Vector2d& point, const Polygon& polygon) {
+  if (polygon.empty()) return kInf;
+  if (polygon.size() >= 3 && pointInPolygon(point, polygon)) return 0.0;
+  double best = kInf;
+  for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
+    best = std::min(best, pointSegmentDistance(point, polygon[b], polygon[a]));
+  }
+  return best;
+}
+
+double World2D::distanceToDynamicPolygons(const Eigen::Vector2d& point) const {
+  double best = kInf;
+  for (const Polygon& p : dynamic_) best = std::min(best, pointPolygonDistance(point, p));
+  return best;
+}
 
 World2D::World2D(double bucket_size_m) : bucket_(bucket_size_m) {
   if (!(bucket_size_m > 0.0)) throw std::invalid_argument("World2D: bucket size must be positive");
@@ -176,6 +200,7 @@ double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double 
   for (std::size_t i = 0; i < dynamic_.size(); ++i) {
     if (static_cast<int>(i) != skip_dynamic) best = std::min(best, rayPolygon(origin, d, dynamic_[i]));
   }
+  for (const Eigen::Vector3d& c : dynamic_circles_) best = std::min(best, rayCircle(origin, d, c.head<2>(), c.z()));
   if (nx_ > 0) {
     // Clip the ray to the grid's box (slab method).
     double t0 = 0.0, t1 = max_range_m;
@@ -254,6 +279,9 @@ bool World2D::overlaps(const Polygon& polygon, int skip_dynamic) const {
   for (std::size_t i = 0; i < dynamic_.size(); ++i) {
     if (static_cast<int>(i) != skip_dynamic && polygonsOverlap(polygon, dynamic_[i])) return true;
   }
+  for (const Eigen::Vector3d& c : dynamic_circles_) {
+    if (polygonTouchesCircle(polygon, c.head<2>(), c.z())) return true;
+  }
   if (nx_ > 0) {
     int x0, y0, x1, y1;
     bucketRange(lo, hi, x0, y0, x1, y1);
@@ -270,10 +298,7 @@ bool World2D::overlaps(const Polygon& polygon, int skip_dynamic) const {
             }
           } else {
             const Circle& c = circles_[-1 - item];
-            if (pointInPolygon(c.c, polygon)) return true;
-            for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
-              if (pointSegmentDistance(c.c, polygon[b], polygon[a]) < c.r) return true;
-            }
+            if (polygonTouchesCircle(polygon, c.c, c.r)) return true;
           }
         }
       }

@@ -125,6 +125,30 @@ class SimHomeTest(unittest.TestCase):
         # The simulator still serves the first robot.
         self.assertTrue(self.get_state(model_name='robot').success)
 
+    def test_4b_a_person_spawned_at_run_time_is_seen_touched_and_deleted(self):
+        from mbot_slam_navigation.srv import DeleteModel
+        spawn = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)
+        self.teleport(-3.5, -2.0, 0.0)
+        req = SpawnModelRequest(model_name='visitor', model_xml='<sdf version="1.6"><actor name="a"/></sdf>')
+        req.initial_pose.position.x, req.initial_pose.position.y, req.initial_pose.orientation.w = -2.0, -2.0, 1.0
+        res = spawn(req)
+        self.assertTrue(res.success, res.status_message)
+        ahead = lambda scan: scan.ranges[int(round(-scan.angle_min / scan.angle_increment))]  # noqa: E731
+        # The laser sits over the base (robot.xacro): the person's near side is 1.5 - 0.25 m away.
+        self.assertAlmostEqual(ahead(self.fresh_scan()), 1.25, delta=0.05)
+        state = self.get_state(model_name='visitor')
+        self.assertTrue(state.success)
+        self.assertAlmostEqual(state.pose.position.x, -2.0, delta=1e-6)
+        del self.contacts[:]
+        self.drive(0.3, 0.0, 6.0)  # straight into the person
+        self.assertEqual([(c.other, c.other_kind, c.robot_at_fault) for c in self.contacts],
+                         [('visitor', 'person', True)])
+        bad = spawn(SpawnModelRequest(model_name='box', model_xml='<sdf version="1.6"><model name="b"/></sdf>'))
+        self.assertFalse(bad.success)
+        self.assertIn('no <actor>', bad.status_message)
+        self.assertTrue(rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)(model_name='visitor').success)
+        self.assertGreater(ahead(self.fresh_scan()), 1.5)
+
     def test_5_pause_stops_the_clock_and_unpause_resumes(self):
         from rosgraph_msgs.msg import Clock
         from std_srvs.srv import Empty

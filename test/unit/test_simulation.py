@@ -64,3 +64,89 @@ def test_two_robots_see_and_block_each_other():
     assert sim.scan(a, a.lasers[0])[180] == pytest.approx(1.5 - 0.3, abs=1e-6)  # b's rear face
     run(sim, 'a', 0.4, 0.0, 5.0)
     assert a.collisions == 1 and sim.get('b').pose[0] == pytest.approx(-1.5)
+
+
+PERSON_SDF = '''<sdf version="1.6"><world name="w">
+  <actor name="walker"><script><loop>true</loop><delay_start>1.0</delay_start>
+    <trajectory id="0" type="walking">
+      <waypoint><time>0</time><pose>-4 -2 1 0 0 0</pose></waypoint>
+      <waypoint><time>4</time><pose>0 -2 1 0 0 0</pose></waypoint>
+    </trajectory>
+    <trajectory id="1" type="walking">
+      <waypoint><time>0</time><pose>0 -2 1 0 0 3.1416</pose></waypoint>
+      <waypoint><time>4</time><pose>-4 -2 1 0 0 3.1416</pose></waypoint>
+    </trajectory></script></actor>
+</world></sdf>'''
+
+
+def people_world(text=PERSON_SDF):
+    from mbot_slam_navigation.sim.sdf_world import parse_world
+    world = load_world(HOME)
+    world.actors = parse_world(text).actors
+    return world
+
+
+def test_a_person_walks_the_script_in_order_and_loops():
+    sim = Simulation(people_world(), slip_stddev=0.0)
+    p = sim.people['walker']
+    assert p.pose[:2] == (-4.0, -2.0)
+    for t, x in ((0.5, -4.0), (1.0, -4.0), (3.0, -2.0), (5.0, 0.0), (7.0, -2.0), (9.0, -4.0), (11.0, -2.0)):
+        while sim.time < t - 1e-9:
+            sim.step()
+        assert p.pose[0] == pytest.approx(x, abs=0.02), t  # 1 s delay, 4 s out, 4 s back, then again
+    assert sim.people['walker'].actor.radius == pytest.approx(0.25)
+
+
+def test_lasers_see_a_person_and_a_robot_that_drives_into_one_is_at_fault():
+    standing = '''<sdf version="1.6"><actor name="bob"><pose>-1 -2 0 0 0 0</pose>
+      <link name="l"><collision name="c"><geometry><cylinder><radius>0.3</radius><length>1.7</length></cylinder>
+      </geometry></collision></link></actor></sdf>'''
+    from mbot_slam_navigation.sim.sdf_world import parse_actors
+    sim = Simulation(load_world(HOME), slip_stddev=0.0)
+    robot = sim.spawn('r', robot_spec(), (-3.0, -2.0, 0.0))
+    sim.add_person(parse_actors(standing)[0])
+    assert sim.scan(robot, robot.lasers[0])[180] == pytest.approx(2.0 - 0.3, abs=1e-6)  # beam 180 looks along +x
+    run(sim, 'r', 0.4, 0.0, 6.0)
+    assert robot.collisions == 1 and robot.at_fault_collisions == 1
+    assert robot.pose[0] + 0.3 < -1.3 + 1e-6  # stopped at the person's edge
+    sim.delete('bob')
+    assert sim.scan(robot, robot.lasers[0])[180] > 3.0  # gone: the next thing ahead is far
+    with pytest.raises(SimulationError, match='"bob"'):
+        sim.delete('bob')
+
+
+def test_a_person_yields_to_a_robot_then_walks_on_and_it_is_not_the_robots_fault():
+    from mbot_slam_navigation.sim import simulation
+    sim = Simulation(people_world(), slip_stddev=0.0)
+    robot = sim.spawn('r', robot_spec(), (-2.0, -2.0, math.pi / 2))  # standing across the walker's line
+    p = sim.people['walker']
+    run(sim, 'r', 0.0, 0.0, 4.0)
+    # The walker stops short of the robot (its gap kept) and waits ...
+    gap = abs(p.pose[0] - (-2.0)) - 0.3 - p.actor.radius   # robot's half width along x is 0.3 at most
+    assert p.pose[0] < -2.0 and p.waited > 0.0 and gap > -0.05
+    assert robot.collisions == 0
+    # ... for PERSON_PATIENCE, then walks on through; counted, but not as the robot's fault.
+    furthest = p.pose[0]
+    for _ in range(int((simulation.PERSON_PATIENCE + 4.0) / sim.step_size)):
+        sim.step()
+        furthest = max(furthest, p.pose[0])
+    assert furthest > -0.5
+    assert robot.collisions == 1 and robot.at_fault_collisions == 0
+
+
+def test_people_reset_with_the_simulation_and_bad_scripts_name_the_line():
+    from mbot_slam_navigation.sim.sdf_world import parse_world
+    from mbot_slam_navigation.sim.xmlutil import XmlError
+    sim = Simulation(people_world(), slip_stddev=0.0)
+    for _ in range(300):
+        sim.step()
+    assert sim.people['walker'].pose[0] > -4.0
+    sim.reset()
+    assert sim.people['walker'].pose[:2] == (-4.0, -2.0) and sim.time == 0.0
+    bad = PERSON_SDF.replace('<time>4</time><pose>0 -2', '<time>-1</time><pose>0 -2')
+    with pytest.raises(XmlError, match=r'people.world:5: <waypoint>.*must not decrease'):
+        parse_world(bad, 'people.world')
+    with pytest.raises(SimulationError, match='follows its script'):
+        sim.set_pose('walker', (0.0, 0.0, 0.0))
+    with pytest.raises(SimulationError, match='exists already'):
+        sim.add_person(sim.people['walker'].actor)

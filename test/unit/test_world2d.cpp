@@ -80,6 +80,29 @@ TEST(World2D, CylinderAndDynamicPolygons) {
   EXPECT_FALSE(w.overlaps(square(1.5, 0.5, 0.05), 0));
 }
 
+TEST(World2D, DynamicCirclesAreSeenAndCollide) {
+  // People: round moving obstacles, seen by rays and touched by footprints; replaced each step.
+  World2D w = squareRoom();
+  EXPECT_NEAR(w.castRay({0, 0}, 0.0, 10.0), 2.0, 1e-12);
+  w.setDynamicCircles({Eigen::Vector3d(1.0, 0.0, 0.25)});
+  EXPECT_NEAR(w.castRay({0, 0}, 0.0, 10.0), 0.75, 1e-12);
+  EXPECT_TRUE(w.overlaps(square(0.7, 0, 0.1)));
+  EXPECT_FALSE(w.overlaps(square(0.5, 0, 0.1)));
+  w.setDynamicCircles({});
+  EXPECT_NEAR(w.castRay({0, 0}, 0.0, 10.0), 2.0, 1e-12);
+  EXPECT_FALSE(w.overlaps(square(0.7, 0, 0.1)));
+}
+
+TEST(World2D, DistanceToDynamicPolygons) {
+  World2D w;
+  EXPECT_TRUE(std::isinf(w.distanceToDynamicPolygons({0, 0})));
+  w.setDynamicPolygons({square(0, 0, 0.2), square(3, 0, 0.2)});
+  EXPECT_DOUBLE_EQ(w.distanceToDynamicPolygons({0.1, 0.1}), 0.0);  // inside
+  EXPECT_NEAR(w.distanceToDynamicPolygons({1.0, 0.0}), 0.8, 1e-12);
+  EXPECT_NEAR(w.distanceToDynamicPolygons({2.0, 0.0}), 0.8, 1e-12);
+  EXPECT_NEAR(mbot::core::pointPolygonDistance({0.5, 0.5}, square(0, 0, 0.2)), std::sqrt(0.18), 1e-12);
+}
+
 TEST(World2D, FootprintOverlap) {
   const World2D w = squareRoom();
   EXPECT_FALSE(w.overlaps(square(0, 0, 0.2)));

@@ -69,3 +69,29 @@ def test_a_bad_rooms_file_names_the_file_and_the_entry(tmp_path):
     bad.write_text('rooms:\n- {name: hall, xmin: 2, xmax: 1, ymin: 0, ymax: 1}\n')
     with pytest.raises(ValueError, match='"hall"'):
         load_rooms(str(bad))
+
+
+def test_the_people_in_the_home_walk_clear_of_walls_and_through_several_rooms():
+    """Each person of mbot_home_people.world keeps 0.1 m from walls and furniture along its whole
+    loop, and visits more than one room; the static part is the home's."""
+    import numpy as np
+    from mbot_slam_navigation import _core
+    people = load_world(os.path.join(PKG, 'worlds', 'mbot_home_people.world'))
+    home = load_world(os.path.join(PKG, 'worlds', 'mbot_sim_gazebo_navigation.world'))
+    assert len(people.shapes) == len(home.shapes) and len(people.actors) >= 2
+    geometry = _core._World2D(0.5)
+    for s in home.shapes:
+        if s.kind == 'box':
+            geometry.add_box(np.array([s.x, s.y]), s.yaw, s.size_x, s.size_y)
+        else:
+            geometry.add_cylinder(np.array([s.x, s.y]), s.radius)
+    for a in people.actors:
+        assert a.loop and a.duration > 10.0
+        rooms = set()
+        for t in np.arange(0.0, a.duration, 0.05):
+            x, y, _ = a.pose_at(t)
+            ring = [np.array([x + (a.radius + 0.1) * np.cos(k), y + (a.radius + 0.1) * np.sin(k)])
+                    for k in np.linspace(0, 2 * np.pi, 16, endpoint=False)]
+            assert not geometry.overlaps(ring), '%s at %.1f s: (%.2f, %.2f) is too close to a wall' % (a.name, t, x, y)
+            rooms |= {r.name for r in HOME_ROOMS if r.xmin <= x <= r.xmax and r.ymin <= y <= r.ymax}
+        assert len(rooms) >= 2, '%s stays in %s' % (a.name, rooms)

@@ -17,6 +17,9 @@ namespace core {
 
 using Polygon = std::vector<Eigen::Vector2d>;  ///< vertices in order (either winding), closed implicitly
 
+/// Distance [m] from `point` to the solid polygon: 0 inside it, else to its nearest side.
+double pointPolygonDistance(const Eigen::Vector2d& point, const Polygon& polygon);
+
 class World2D {
  public:
   /// Bucket edge length [m] of the ray-casting acceleration grid.
@@ -31,6 +34,12 @@ class World2D {
 
   /// Moving obstacles (other robots' footprints), replaced wholesale each step; tested brute force.
   void setDynamicPolygons(const std::vector<Polygon>& polygons) { dynamic_ = polygons; }
+  /// Moving round obstacles (people): each (x, y, radius) [m], replaced wholesale each step; seen by
+  /// rays and by overlap tests like any shape, tested brute force.
+  void setDynamicCircles(const std::vector<Eigen::Vector3d>& circles) { dynamic_circles_ = circles; }
+
+  /// Distance [m] from `point` to the nearest dynamic polygon (0 inside one), +inf if there is none.
+  double distanceToDynamicPolygons(const Eigen::Vector2d& point) const;
 
   /// Distance [m] from `origin` along `angle_rad` to the first surface, or +inf if none within
   /// `max_range_m`. Dynamic polygon `skip_dynamic` (the caster's own body) is ignored.
@@ -65,6 +74,7 @@ class World2D {
   std::vector<Circle> circles_;
   std::vector<Polygon> solids_;   // boxes and polygons, for containment tests
   std::vector<Polygon> dynamic_;
+  std::vector<Eigen::Vector3d> dynamic_circles_;
 
   // Acceleration grid (CSR: for bucket k, items [offsets[k], offsets[k+1]) of `items`; an item >= 0
   // is a segment index, < 0 is circle index -1-item). Rebuilt lazily after shapes change.

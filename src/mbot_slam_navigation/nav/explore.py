@@ -149,8 +149,11 @@ class Explore:
         self.scan = msg
 
     def on_contact(self, msg: Contact) -> None:
+        if not msg.robot_at_fault:  # a person walked into the robot: the simulator logs it; not ours
+            return
         self.collisions += 1
-        rospy.logwarn('explore: the robot touched something at (%.2f, %.2f)', msg.pose.x, msg.pose.y)
+        rospy.logwarn('explore: the robot touched %s at (%.2f, %.2f)',
+                      'the world' if msg.other_kind in ('', 'world') else msg.other, msg.pose.x, msg.pose.y)
 
     def robot_pose(self) -> Optional[Tuple[float, float, float]]:
         try:

@@ -10,7 +10,8 @@ pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false), odo
 
 Publishes /clock; per robot (in its namespace): the drive's odometry topic and odom -> base tf,
 each laser's LaserScan, base_pose_ground_truth (nav_msgs/Odometry in the world frame). Services
-<ns>/spawn_urdf_model, delete_model, get_model_state, set_model_state, pause_physics,
+<ns>/spawn_urdf_model, spawn_sdf_model (people: SDF <actor>s), delete_model, get_model_state,
+set_model_state (robots and people), pause_physics,
 unpause_physics, reset_simulation, reset_world; topic <ns>/contacts (mbot_slam_navigation/Contact).
 ~real_time_factor (std_msgs/Float64, every 0.25 s wall: the factor reached) with a line every 10 s
 wall when auto. Message stamps are simulated time; the node itself paces on the wall clock.
@@ -37,7 +38,7 @@ from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.nonblocking_publisher import nonblocking_publisher
 from mbot_slam_navigation.sim import pacing
 from mbot_slam_navigation.sim.pacing import PacingError, make_pacer
-from mbot_slam_navigation.sim.sdf_world import World, load_world
+from mbot_slam_navigation.sim.sdf_world import World, load_world, parse_actors
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
 from mbot_slam_navigation.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
                                                  yaw_to_quaternion)
@@ -99,8 +100,8 @@ class SimNode:
             world = World(name='empty')
         for w in world.warnings:
             rospy.logwarn('gazebo_sim: %s', w)
-        rospy.loginfo('gazebo_sim: world "%s" from %s: %d shapes', world.name, world_path or '(empty)',
-                      len(world.shapes))
+        rospy.loginfo('gazebo_sim: world "%s" from %s: %d shapes%s', world.name, world_path or '(empty)',
+                      len(world.shapes), ', %d people' % len(world.actors) if world.actors else '')
         self.sim = Simulation(world, step_size=step,
                               slip_stddev=float(rospy.get_param('~odometry_slip_stddev', 0.02)),
                               cmd_timeout=float(rospy.get_param('~cmd_vel_timeout', 0.5)),
@@ -117,6 +118,7 @@ class SimNode:
         rospy.Subscriber('/sim_heartbeat', Header, self.on_heartbeat, queue_size=50)
         s = self.gz_ns + '/'
         rospy.Service(s + 'spawn_urdf_model', SpawnModel, self.on_spawn)
+        rospy.Service(s + 'spawn_sdf_model', SpawnModel, self.on_spawn_sdf)
         rospy.Service(s + 'delete_model', DeleteModel, self.on_delete)
         rospy.Service(s + 'get_model_state', GetModelState, self.on_get_state)
         rospy.Service(s + 'set_model_state', SetModelState, self.on_set_state)
@@ -160,11 +162,37 @@ class SimNode:
                       ', '.join(p.resolved_name for p in io.scan_pubs) or 'none')
         return SpawnModelResponse(True, 'SpawnModel: model "%s" spawned' % robot.name)
 
+    def on_spawn_sdf(self, req):
+        """People at run time: SDF with one or more <actor>s. One actor takes the request's model_name;
+        the initial pose moves the actor's pose and waypoints (Gazebo's spawn pose of a model)."""
+        try:
+            if req.reference_frame not in ('', 'world', 'map'):
+                raise SimulationError('reference_frame "%s": only the world frame is supported' % req.reference_frame)
+            actors = parse_actors(req.model_xml, 'model_xml of "%s"' % req.model_name)
+            q = req.initial_pose.orientation
+            yaw = quaternion_to_yaw(q.x, q.y, q.z, q.w) if (q.x, q.y, q.z, q.w) != (0, 0, 0, 0) else 0.0
+            actors = [a.moved(req.initial_pose.position.x, req.initial_pose.position.y, yaw) for a in actors]
+            if len(actors) == 1 and req.model_name:
+                actors[0].name = req.model_name
+            with self.lock:
+                for a in actors:
+                    a.delay_start += self.sim.time  # its script starts now
+                    self.sim.add_person(a)
+        except (XmlError, SimulationError, ValueError) as e:
+            rospy.logerr('gazebo_sim: cannot spawn "%s": %s', req.model_name, e)
+            return SpawnModelResponse(False, 'SpawnModel: %s' % e)
+        for a in actors:
+            rospy.loginfo('gazebo_sim: person "%s" (r %.2f m) %s', a.name, a.radius,
+                          'walking %d waypoints' % len(a.waypoints) if a.waypoints
+                          else 'standing at (%.2f, %.2f)' % (a.x, a.y))
+        return SpawnModelResponse(True, 'SpawnModel: %s spawned' % ', '.join('"%s"' % a.name for a in actors))
+
     def on_delete(self, req):
         try:
             with self.lock:
                 self.sim.delete(req.model_name)
-                self.io.pop(req.model_name).close()
+                if req.model_name in self.io:
+                    self.io.pop(req.model_name).close()
         except SimulationError as e:
             return DeleteModelResponse(False, 'DeleteModel: %s' % e)
         return DeleteModelResponse(True, 'DeleteModel: "%s" deleted' % req.model_name)
@@ -175,19 +203,19 @@ class SimNode:
         res.header.frame_id = req.relative_entity_name or 'world'
         try:
             with self.lock:
-                robot = self.sim.get(req.model_name)
-                pose = robot.pose
+                pose = world_pose = self.sim.model_pose(req.model_name)
                 if req.relative_entity_name not in ('', 'world', 'map'):
-                    ref = self.sim.get(req.relative_entity_name).pose
+                    ref = self.sim.model_pose(req.relative_entity_name)
                     c, s = math.cos(ref[2]), math.sin(ref[2])
                     dx, dy = pose[0] - ref[0], pose[1] - ref[1]
                     pose = (c * dx + s * dy, -s * dx + c * dy, pose[2] - ref[2])
-                v, w = robot.drive.linear_velocity, robot.drive.angular_velocity
+                robot = self.sim.robots.get(req.model_name)
+                v, w = (robot.drive.linear_velocity, robot.drive.angular_velocity) if robot else (0.0, 0.0)
         except SimulationError as e:
             res.success, res.status_message = False, 'GetModelState: %s' % e
             return res
         res.pose = pose_msg(*pose)
-        res.twist.linear.x, res.twist.linear.y = v * math.cos(robot.pose[2]), v * math.sin(robot.pose[2])
+        res.twist.linear.x, res.twist.linear.y = v * math.cos(world_pose[2]), v * math.sin(world_pose[2])
         res.twist.angular.z = w
         res.success, res.status_message = True, 'GetModelState: got properties'
         return res
@@ -352,10 +380,17 @@ class SimNode:
                     self.publish_robot(io, stamp, due_odom, due_lasers)
             if publish_clock:
                 self.clock_pub.publish(Clock(clock=stamp))
-            for r in contacts:
-                rospy.logwarn('gazebo_sim: "%s" collided at (%.2f, %.2f); %d collisions so far',
-                              r.name, r.pose[0], r.pose[1], r.collisions)
-                c = Contact(model_name=r.name, pose=Pose2D(*r.pose), total_collisions=r.collisions)
+            for e in contacts:
+                r = e.robot
+                if e.robot_at_fault:
+                    rospy.logwarn('gazebo_sim: "%s" collided with %s at (%.2f, %.2f); %d collisions so far',
+                                  r.name, 'the world' if e.kind == 'world' else '%s "%s"' % (e.kind, e.other),
+                                  r.pose[0], r.pose[1], r.collisions)
+                else:
+                    rospy.loginfo('gazebo_sim: person "%s" walked into "%s" at (%.2f, %.2f) (not the robot\'s fault)',
+                                  e.other, r.name, r.pose[0], r.pose[1])
+                c = Contact(model_name=r.name, pose=Pose2D(*r.pose), total_collisions=r.collisions, other=e.other,
+                            other_kind=e.kind, robot_at_fault=e.robot_at_fault)
                 c.header.stamp, c.header.frame_id = stamp, 'world'
                 self.contact_pub.publish(c)
             if self.viewer is not None and time.monotonic() - last_viewer > 0.05:

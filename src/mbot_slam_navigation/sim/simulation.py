@@ -2,6 +2,12 @@
 
 All poses are (x [m], y [m], yaw [rad]) of base frames in the world frame; time is seconds of
 simulated time. The hot loops (ray casting, collision) run in the C++ core.
+
+People (SDF actors) walk their scripts; lasers see them and robots collide with them. A person
+yields: while its next step would bring it within YIELD_MARGIN of a robot (and closer than it is),
+its script waits; after PERSON_PATIENCE s of waiting it walks on regardless, as Gazebo's actors
+always do, so that nothing waits forever. A contact is the robot's fault only when the robot moved
+into what it touched; a person walking into a robot is counted, but as the person's.
 """
 from collections import OrderedDict
 from dataclasses import dataclass, field
@@ -10,11 +16,35 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from mbot_slam_navigation import _core
-from mbot_slam_navigation.sim.sdf_world import World
+from mbot_slam_navigation.sim.sdf_world import Actor, World
 from mbot_slam_navigation.transforms import compose2d
 from mbot_slam_navigation.sim.urdf_robot import LaserSpec, RobotSpec
 
 Pose2D = Tuple[float, float, float]
+YIELD_MARGIN = 0.1      # [m] a person keeps this gap to a robot while it can
+PERSON_PATIENCE = 10.0  # [s] of simulated time a person waits for a robot before walking on
+TOUCH = 0.02            # [m] a robot stopped this close to a person touched it
+
+
+@dataclass
+class Person:
+    actor: Actor
+    script_time: float = 0.0          # [s] of its script played (stops while it yields)
+    waited: float = 0.0               # [s] yielding so far, without a step
+    pose: Pose2D = (0.0, 0.0, 0.0)
+
+    @property
+    def name(self) -> str:
+        return self.actor.name
+
+
+@dataclass
+class ContactEvent:
+    """A robot came into contact with something: 'world' (walls, furniture), a person or a robot."""
+    robot: 'Robot'
+    other: str                        # 'world', or the person's or robot's model name
+    kind: str                         # 'world', 'person' or 'robot'
+    robot_at_fault: bool              # the robot moved into it
 
 
 @dataclass
@@ -34,6 +64,7 @@ class Robot:
     lasers: List[Laser] = field(default_factory=list)
     collisions: int = 0                # contact episodes so far
     in_contact: bool = False
+    at_fault_collisions: int = 0       # episodes where the robot moved into what it touched
     next_odom_time: float = 0.0
 
     @property
@@ -61,12 +92,15 @@ class Simulation:
         self.seed = seed
         self.steps = 0  # time is counted in whole steps so that stamps do not drift by rounding
         self.robots: Dict[str, Robot] = OrderedDict()
+        self.people: Dict[str, Person] = OrderedDict()
         self.geometry = _core._World2D(0.5)
         for s in world.shapes:
             if s.kind == 'box':
                 self.geometry.add_box(np.array([s.x, s.y]), s.yaw, s.size_x, s.size_y)
             else:
                 self.geometry.add_cylinder(np.array([s.x, s.y]), s.radius)
+        for actor in world.actors:
+            self.add_person(actor)
 
     @property
     def time(self) -> float:
@@ -74,8 +108,19 @@ class Simulation:
         return round(self.steps * self.step_size, 9)
 
     # --- models -------------------------------------------------------------------------------
+    def add_person(self, actor: Actor) -> Person:
+        """A person (an SDF actor) that walks its script from the current time on."""
+        if actor.name in self.robots or actor.name in self.people:
+            raise SimulationError('a model named "%s" exists already' % actor.name)
+        if not actor.radius > 0:
+            raise SimulationError('person "%s": radius must be positive, got %r' % (actor.name, actor.radius))
+        person = Person(actor, pose=actor.pose_at(0.0))
+        self.people[actor.name] = person
+        self._update_people()
+        return person
+
     def spawn(self, name: str, spec: RobotSpec, pose: Pose2D, namespace: str = '') -> Robot:
-        if name in self.robots:
+        if name in self.robots or name in self.people:
             raise SimulationError('a model named "%s" exists already' % name)
         params = _core._DiffDriveParams()
         params.wheel_separation = spec.drive.wheel_separation
@@ -96,18 +141,39 @@ class Simulation:
         return robot
 
     def delete(self, name: str) -> None:
+        if name in self.people:
+            del self.people[name]
+            self._update_people()
+            return
         self.get(name)
         del self.robots[name]
         self._update_dynamic()
+
+    def model_pose(self, name: str) -> Pose2D:
+        """The pose of a robot or a person."""
+        if name in self.people:
+            return self.people[name].pose
+        return self.get(name).pose
 
     def get(self, name: str) -> Robot:
         try:
             return self.robots[name]
         except KeyError:
+            if name in self.people:
+                raise SimulationError('"%s" is a person, not a robot' % name) from None
             raise SimulationError('no model named "%s" (models: %s)'
-                                  % (name, ', '.join(self.robots) or 'none')) from None
+                                  % (name, ', '.join(list(self.robots) + list(self.people)) or 'none')) from None
 
     def set_pose(self, name: str, pose: Pose2D) -> None:
+        person = self.people.get(name)
+        if person is not None:
+            if person.actor.waypoints and person.actor.auto_start:
+                raise SimulationError('person "%s" follows its script; delete it and spawn one without a script '
+                                      'to place it' % name)
+            person.actor.x, person.actor.y, person.actor.yaw = pose
+            person.pose = tuple(pose)
+            self._update_people()
+            return
         self.get(name).drive.set_pose(np.asarray(pose, float))
         self._update_dynamic()
 
@@ -120,27 +186,77 @@ class Simulation:
             r.next_odom_time = 0.0
             for l in r.lasers:
                 l.next_time = 0.0
+        for p in self.people.values():
+            p.script_time, p.waited, p.pose = 0.0, 0.0, p.actor.pose_at(0.0)
         self.steps = 0
         self._update_dynamic()
+        self._update_people()
 
     def command(self, name: str, v: float, w: float) -> bool:
         """Velocity command; False (and ignored) when v or w is not finite."""
         return self.get(name).drive.command(float(v), float(w), self.time)
 
     # --- stepping -----------------------------------------------------------------------------
-    def step(self) -> List[Robot]:
-        """Advances one step; returns the robots that came into contact with something."""
+    def step(self) -> List[ContactEvent]:
+        """Advances one step; returns the contacts that began in it."""
         new_contacts = []
+        walked_into = self._step_people() if self.people else {}
         for i, r in enumerate(self.robots.values()):
             blocked = r.drive.step(self.step_size, self.time, self.geometry, i)
-            if blocked and not r.in_contact:
+            touching = blocked or r.name in walked_into
+            if touching and not r.in_contact:
+                if r.name in walked_into:
+                    event = ContactEvent(r, walked_into[r.name], 'person', robot_at_fault=False)
+                else:
+                    other, kind = self._touched_by(r, i)
+                    event = ContactEvent(r, other, kind, robot_at_fault=True)
                 r.collisions += 1
-                new_contacts.append(r)
-            r.in_contact = blocked
+                r.at_fault_collisions += event.robot_at_fault
+                new_contacts.append(event)
+            r.in_contact = touching
         self.steps += 1
-        if len(self.robots) > 1:
+        if len(self.robots) > 1 or self.people:
             self._update_dynamic()
         return new_contacts
+
+    def _step_people(self) -> Dict[str, str]:
+        """Moves the people one step; returns {robot: person} for people now overlapping a robot."""
+        dt, now = self.step_size, self.time
+        walked_into = {}
+        for p in self.people.values():
+            a = p.actor
+            if now < a.delay_start or not a.waypoints:
+                continue
+            nx, ny, nyaw = a.pose_at(p.script_time + dt)
+            ahead = self.geometry.distance_to_dynamic_polygons(np.array([nx, ny]))
+            if ahead < a.radius + YIELD_MARGIN and p.waited < PERSON_PATIENCE:
+                here = self.geometry.distance_to_dynamic_polygons(np.array(p.pose[:2]))
+                if ahead < here and (nx, ny) != p.pose[:2]:
+                    p.waited += dt  # a robot is in the way: wait for it to pass
+                    continue
+            if ahead >= a.radius + YIELD_MARGIN:
+                p.waited = 0.0  # clear of robots; after a wait, it keeps walking until it is
+            p.script_time += dt
+            p.pose = (nx, ny, nyaw)
+            if ahead < a.radius:
+                for r in self.robots.values():
+                    if _core._point_polygon_distance(np.array([nx, ny]), r.drive.footprint_in_world()) < a.radius:
+                        walked_into[r.name] = p.name
+        self._update_people()
+        return walked_into
+
+    def _touched_by(self, robot: Robot, index: int) -> Tuple[str, str]:
+        """What a robot that was just stopped touches: ('person name', 'person'), ('robot name',
+        'robot') or ('world', 'world')."""
+        footprint = robot.drive.footprint_in_world()
+        for p in self.people.values():
+            if _core._point_polygon_distance(np.array(p.pose[:2]), footprint) < p.actor.radius + TOUCH:
+                return p.name, 'person'
+        for j, other in enumerate(self.robots.values()):
+            if j != index and min(_core._point_polygon_distance(np.asarray(v, float), other.drive.footprint_in_world())
+                                  for v in footprint) < TOUCH:
+                return other.name, 'robot'
+        return 'world', 'world'
 
     def scan(self, robot: Robot, laser: Laser) -> np.ndarray:
         """A scan from the laser's current pose: float32 ranges, REP 117."""
@@ -149,6 +265,9 @@ class Simulation:
         return _core._cast_scan(self.geometry, np.asarray(robot.laser_pose(laser), float), s.angle_min,
                                 s.angle_increment, s.samples, s.range_min, s.range_max, s.noise_stddev,
                                 s.range_resolution, laser.rng, index)
+
+    def _update_people(self) -> None:
+        self.geometry.set_dynamic_circles([np.array([p.pose[0], p.pose[1], p.actor.radius]) for p in self.people.values()])
 
     def _update_dynamic(self, extra: Optional[Robot] = None) -> None:
         robots = list(self.robots.values()) + ([extra] if extra is not None else [])

@@ -1,4 +1,4 @@
-"""gui:=true: a top-down OpenCV window of the world, the robots' footprints and their laser rays."""
+"""gui:=true: a top-down OpenCV window of the world, the people, the robots' footprints and their laser rays."""
 import math
 
 import cv2
@@ -43,5 +43,10 @@ class TopDownViewer:
                     p = self.px([(x, y), (x + r * math.cos(a), y + r * math.sin(a))])
                     cv2.line(img, tuple(p[0]), tuple(p[1]), (80, 80, 255), 1)
             cv2.polylines(img, [self.px(robot.drive.footprint_in_world())], True, (200, 120, 0), 2)
+        for person in sim.people.values():
+            x, y, yaw = person.pose
+            c = self.px([(x, y), (x + person.actor.radius * math.cos(yaw), y + person.actor.radius * math.sin(yaw))])
+            cv2.circle(img, tuple(c[0]), int(person.actor.radius * self.scale), (40, 140, 230), -1)
+            cv2.line(img, tuple(c[0]), tuple(c[1]), (0, 60, 120), 2)  # which way the person faces
         cv2.imshow(self.window, img)
         cv2.waitKey(1)
