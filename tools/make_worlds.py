@@ -46,14 +46,17 @@ HOME_ROOMS = [
 ]
 
 # People of mbot_home_people.world: name and route (x, y) [m], walked there and back at WALK_SPEED,
+# living room <-> kitchen, master bedroom <-> balcony, study <-> bathroom,
 # waiting PAUSE s at each end; every route goes through doors, at least 0.1 m clear of walls and
 # furniture (a person is a 0.25 m cylinder; a 0.9 m door leaves 0.15 m each side).
 WALK_SPEED = 0.8  # [m/s] an unhurried walk indoors
 PAUSE = 5.0       # [s]
-HOME_PEOPLE = [
-    ('alice', [(-3.0, -2.0), (0.6, -2.4), (2.0, -2.4), (2.8, -3.05), (3.05, -3.45), (3.05, -4.3)]),        # living room -> kitchen
-    ('bob', [(-3.8, 2.0), (-2.75, 1.3), (-2.75, 0.0), (-4.0, -1.6), (-5.4, -2.0), (-6.4, -2.0)]),  # bedroom -> balcony
-    ('carol', [(-0.6, 1.9), (-1.15, 1.3), (-1.15, 0.2), (0.3, -0.05), (1.2, -0.05), (2.4, -0.3)]),  # study -> bathroom
+HOME_PEOPLE = [  # each rests away from the spawn point and from random_navigation's points p1..p9
+    ('alice', [(-3.0, -2.0), (0.6, -2.4), (2.0, -2.4), (2.8, -3.05), (3.05, -3.45), (3.05, -4.0), (2.0, -5.3)]),
+    ('bob', [(-4.3, 3.0), (-3.8, 2.2), (-2.75, 1.3), (-2.75, 0.0), (-4.0, -1.6), (-5.4, -2.0), (-6.2, -2.0),
+             (-6.9, -3.3)]),
+    ('carol', [(-1.5, 1.9), (-1.15, 1.3), (-1.15, 0.2), (-0.6, -0.8), (0.6, -0.8), (0.7, -0.05), (1.2, -0.05),
+               (2.4, -0.3)]),
 ]
 
 # wall.world: a 10 m x 10 m enclosure; two interior walls leave gaps at opposite ends, so the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <set>
@@ -50,7 +51,7 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
   const ParamValue sf = r.raw("sensor_frame", ParamValue::ofString(""));
   s.sensor_frame = sf.type == ParamValue::Type::kString && sf.s.empty() ? "" : r.frame("sensor_frame", "");
   s.observation_persistence = r.number("observation_persistence", 0.0, 0.0);
-  s.expected_update_rate = r.number("expected_update_rate", 0.0, 0.0);
+  s.expected_update_rate = r.number("expected_update_rate", kUnsetExpectedUpdateRate, 0.0);
   const std::string data_type = r.string("data_type", "PointCloud");
   if (data_type != "LaserScan") {
     throw ParamError("parameter " + r.where("data_type") + ": data_type \"" + data_type +
@@ -408,9 +409,18 @@ std::vector<std::string> LayeredCostmap::staleSources(double now) const {
   if (!config_.obstacle_layer) return stale;
   const auto& sources = config_.obstacle_layer->sources;
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    if (sources[i].expected_update_rate <= 0.0) continue;
-    // NaN (no scan yet) compares false: stale.
-    if (!(now - last_stamp_[i] <= sources[i].expected_update_rate)) stale.push_back(sources[i].name);
+    const ObservationSourceConfig& s = sources[i];
+    if (s.expected_update_rate <= 0.0) continue;
+    const double age = now - last_stamp_[i];
+    if (age <= s.expected_update_rate) continue;
+    char why[160];
+    if (std::isnan(age)) {  // no scan yet
+      std::snprintf(why, sizeof why, "no data yet");
+    } else {
+      std::snprintf(why, sizeof why, "no data for %.2f s, expected every %.2f s (expected_update_rate)", age,
+                    s.expected_update_rate);
+    }
+    stale.push_back(s.name + " (topic " + s.topic + "): " + why);
   }
   return stale;
 }

@@ -36,11 +36,9 @@ def stop(proc: subprocess.Popen, grace_s: float = 30.0) -> int:
     return proc.wait()
 
 
-def node_cpu_seconds(launch_pid: int) -> Dict[str, float]:
-    """CPU seconds (user + system) used so far by each node that roslaunch `launch_pid` started,
-    by node name (its __name:= argument), read from /proc."""
-    tick = os.sysconf('SC_CLK_TCK')
-    out = {}
+def _launched(launch_pid: int):
+    """(node name, pid, /proc stat fields) of each process that roslaunch `launch_pid` started and
+    named with __name:=."""
     for entry in os.listdir('/proc'):
         if not entry.isdigit():
             continue
@@ -56,8 +54,19 @@ def node_cpu_seconds(launch_pid: int) -> Dict[str, float]:
             continue
         name = next((a.split(':=', 1)[1] for a in args if a.startswith('__name:=')), None)
         if name:
-            out[name] = (int(fields[11]) + int(fields[12])) / tick
-    return out
+            yield name, int(entry), fields
+
+
+def node_pids(launch_pid: int) -> Dict[str, int]:
+    """The pid of each node that roslaunch `launch_pid` started, by node name (its __name:=)."""
+    return {name: pid for name, pid, _ in _launched(launch_pid)}
+
+
+def node_cpu_seconds(launch_pid: int) -> Dict[str, float]:
+    """CPU seconds (user + system) used so far by each node that roslaunch `launch_pid` started,
+    by node name (its __name:= argument), read from /proc."""
+    tick = os.sysconf('SC_CLK_TCK')
+    return {name: (int(fields[11]) + int(fields[12])) / tick for name, _, fields in _launched(launch_pid)}
 
 
 def summary(r: dict, report_dir: str) -> str:

@@ -90,27 +90,48 @@ def draw_map(m: Grid, path: Sequence[Tuple[float, float]], goals: Sequence[Tuple
     cv2.imwrite(filename, img)
 
 
-def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 400)) -> None:
-    """Explored area [m^2] against simulated time [s], with labelled axes."""
+COLOURS = [(200, 80, 0), (0, 0, 220), (0, 150, 0), (180, 0, 180), (0, 140, 255), (120, 120, 0), (80, 80, 80)]
+
+
+def draw_curves(series: Dict[str, Sequence[Tuple[float, float]]], title: str, filename: str, size=(800, 400),
+                marker_x: Optional[float] = None) -> None:
+    """Line chart of named (x, y) curves with labelled axes and a legend (OpenCV, written atomically);
+    marker_x draws a dotted vertical line there."""
     w, h = size
     img = np.full((h, w, 3), 255, np.uint8)
     left, bottom, top, right = 70, 40, 20, 20
-    t = np.array([c[0] for c in curve] or [0.0])
-    a = np.array([c[1] for c in curve] or [0.0])
-    tmax, amax = max(t.max(), 1.0), max(a.max(), 1.0)
+    xs = [p[0] for c in series.values() for p in c] or [0.0]
+    ys = [p[1] for c in series.values() for p in c] or [0.0]
+    xmax, ymax = max(max(xs), 1.0), max(max(ys), 1.0)
     cv2.line(img, (left, h - bottom), (w - right, h - bottom), (0, 0, 0), 1)
     cv2.line(img, (left, h - bottom), (left, top), (0, 0, 0), 1)
     for i in range(5):
         ty = h - bottom - i * (h - bottom - top) // 4
-        cv2.putText(img, '%.0f' % (amax * i / 4), (5, ty + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
+        cv2.putText(img, '%.0f' % (ymax * i / 4), (5, ty + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
         tx = left + i * (w - left - right) // 4
-        cv2.putText(img, '%.0f' % (tmax * i / 4), (tx - 10, h - bottom + 18), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
-    cv2.putText(img, 'explored area [m^2] against simulated time [s]', (left + 10, top + 12), cv2.FONT_HERSHEY_SIMPLEX,
-                0.5, (0, 0, 0), 1)
-    pts = np.column_stack([left + t / tmax * (w - left - right), h - bottom - a / amax * (h - bottom - top)])
-    if len(pts) > 1:
-        cv2.polylines(img, [pts.astype(np.int32)], False, (200, 80, 0), 2)
-    cv2.imwrite(filename, img)
+        cv2.putText(img, '%.0f' % (xmax * i / 4), (tx - 10, h - bottom + 18), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
+    cv2.putText(img, title, (left + 10, top + 12), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1)
+    to_px = lambda x, y: (left + x / xmax * (w - left - right), h - bottom - y / ymax * (h - bottom - top))  # noqa: E731
+    if marker_x is not None and 0 <= marker_x <= xmax:
+        mx = int(to_px(marker_x, 0)[0])
+        for y0 in range(top, h - bottom, 8):
+            cv2.line(img, (mx, y0), (mx, y0 + 3), (120, 120, 120), 1)
+    for k, (name, curve) in enumerate(series.items()):
+        colour = COLOURS[k % len(COLOURS)]
+        pts = np.array([to_px(x, y) for x, y in curve] or [(0.0, 0.0)])
+        if len(curve) > 1:
+            cv2.polylines(img, [pts.astype(np.int32)], False, colour, 2)
+        if len(series) > 1:
+            cv2.putText(img, name, (w - right - 190, top + 30 + 16 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45, colour, 1)
+    root, ext = os.path.splitext(filename)
+    tmp = root + '.tmp' + ext
+    cv2.imwrite(tmp, img)
+    os.replace(tmp, filename)
+
+
+def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 400)) -> None:
+    """Explored area [m^2] against simulated time [s], with labelled axes."""
+    draw_curves({'area': curve}, 'explored area [m^2] against simulated time [s]', filename, size)
 
 
 def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],

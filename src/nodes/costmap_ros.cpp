@@ -148,7 +148,7 @@ std::pair<bool, std::string> CostmapROS::isCurrent() {
   if (stale.empty()) return {true, ""};
   std::string names;
   for (const auto& s : stale) names += (names.empty() ? "" : ", ") + s;
-  return {false, name_ + ": observation source(s) " + names + " not updated within their expected_update_rate"};
+  return {false, name_ + ": observation source " + names};
 }
 
 void CostmapROS::publish() {

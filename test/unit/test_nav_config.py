@@ -260,9 +260,22 @@ def test_a_source_is_current_while_its_scans_keep_coming_and_stale_after_expecte
     values = {'static_map': False, 'robot_radius': 0.2, 'observation_sources': 'scan',
               'scan': {'data_type': 'LaserScan', 'expected_update_rate': 0.5, 'clearing': True, 'marking': True}}
     lc = LayeredCostmap(CostmapConfig('c', values, lambda w: None), print)
-    assert lc.stale_sources(1.0) == ['scan']  # no scan yet
+    assert lc.stale_sources(1.0) == ['scan (topic scan): no data yet']
     assert lc.add_scan('scan', 1.0, (0.5, 0.5, 0.0), 0.1, 0.0, 0.1, 0.1, 6.0, [1.0])
     lc.update((0.5, 0.5, 0.0))
     lc.update((0.5, 0.5, 0.0))
     assert lc.stale_sources(1.4) == []
-    assert lc.stale_sources(1.6) == ['scan']
+    assert lc.stale_sources(1.6) == ['scan (topic scan): no data for 0.60 s, expected every 0.50 s (expected_update_rate)']
+
+
+def test_a_source_without_expected_update_rate_goes_stale_after_two_seconds_and_an_explicit_zero_never():
+    """costmap_2d's default (0: never stale) lets a silent laser leave the robot driving blind."""
+    for rate, stale_at_3 in ((None, True), (0.0, False)):
+        scan = {'data_type': 'LaserScan', 'clearing': True, 'marking': True}
+        if rate is not None:
+            scan['expected_update_rate'] = rate
+        lc = LayeredCostmap(CostmapConfig('c', {'static_map': False, 'robot_radius': 0.2, 'observation_sources': 'scan',
+                                                'scan': scan}, lambda w: None), print)
+        assert lc.add_scan('scan', 1.0, (0.5, 0.5, 0.0), 0.1, 0.0, 0.1, 0.1, 6.0, [1.0])
+        assert lc.stale_sources(2.9) == []
+        assert bool(lc.stale_sources(3.1)) == stale_at_3

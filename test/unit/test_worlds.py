@@ -95,3 +95,15 @@ def test_the_people_in_the_home_walk_clear_of_walls_and_through_several_rooms():
             assert not geometry.overlaps(ring), '%s at %.1f s: (%.2f, %.2f) is too close to a wall' % (a.name, t, x, y)
             rooms |= {r.name for r in HOME_ROOMS if r.xmin <= x <= r.xmax and r.ymin <= y <= r.ymax}
         assert len(rooms) >= 2, '%s stays in %s' % (a.name, rooms)
+
+
+def test_the_people_rest_away_from_the_spawn_point_and_the_tutorial_points():
+    """Where a person waits (the ends of its route) a robot parked at a goal or at the spawn point
+    must not be in its way: 0.6 m from each point (robot 0.2 + person 0.25 + their gap)."""
+    from mbot_slam_navigation.nav.random_navigation import tutorial_locations
+    people = load_world(os.path.join(PKG, 'worlds', 'mbot_home_people.world'))
+    points = [(0.0, 0.0)] + [(l.x, l.y) for l in tutorial_locations()]
+    for a in people.actors:
+        for w in (a.waypoints[0], a.waypoints[len(a.waypoints) // 2]):
+            near = min(((w.x - x) ** 2 + (w.y - y) ** 2) ** 0.5 for x, y in points)
+            assert near >= 0.6, '%s rests at (%.2f, %.2f), %.2f m from a point' % (a.name, w.x, w.y, near)

@@ -40,6 +40,11 @@ struct StaticLayerConfig {
   bool trinary_costmap = true, enabled = true;
 };
 
+/// expected_update_rate [s] of a source that does not set it. costmap_2d's default is 0 (never
+/// stale), so a laser that falls silent leaves the robot driving blind; here it stops after this
+/// long. An explicit 0 keeps costmap_2d's behaviour.
+constexpr double kUnsetExpectedUpdateRate = 2.0;
+
 struct ObservationSourceConfig {
   std::string name, topic, sensor_frame;  ///< sensor_frame empty: each scan's header frame
   double observation_persistence = 0.0, expected_update_rate = 0.0;  ///< [s]
@@ -103,7 +108,8 @@ class LayeredCostmap {
   /// [min_obstacle_height, max_obstacle_height]: costmap_2d drops every point of such a scan.
   bool addScan(std::size_t source, double stamp, const Eigen::Vector3d& sensor_pose, double sensor_height,
                const LaserScan& scan);
-  /// Sources whose expected_update_rate is overdue at `now` [s] (costmap_2d's isCurrent is false).
+  /// Sources whose expected_update_rate is overdue at `now` [s] (costmap_2d's isCurrent is false),
+  /// each as "name (topic T): why" for the user's message.
   std::vector<std::string> staleSources(double now) const;
   /// One update cycle at `robot_pose` (global frame); returns the window of cells that changed.
   CellWindow update(const Eigen::Vector3d& robot_pose);

@@ -18,6 +18,9 @@ Parameters (private): rest_time (2 s), locations_file ('' = the tutorial's table
 config/wall_locations.yaml for the format), max_goals (0 = forever), max_duration (0 = forever, s
 of ROS time), goal_timeout (300 s), seed (-1 = random), frame_id ('map'), base_frame
 ('base_footprint'), server_timeout (60 s). With a limit it prints a summary and exits 0.
+
+Beyond the tutorial: move_base killed mid-goal (and respawned) is noticed, waited for and the goal
+sent again (pursue()), so a soak's count goes on instead of waiting out goal_timeout.
 """
 import math
 import os
@@ -37,6 +40,9 @@ from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
 from mbot_slam_navigation.transforms import check_planar_quaternion, yaw_to_quaternion
+
+SERVER_SILENCE = 5.0  # [s] of ROS time without move_base's action status (5 Hz) before it counts as gone
+MAX_RESENDS = 2       # times a goal is sent again after move_base lost it
 
 # actionlib_msgs/GoalStatus's states, in the order of their numbers (the tutorial's goal_states).
 GOAL_STATES = ['PENDING', 'ACTIVE', 'PREEMPTED', 'SUCCEEDED', 'ABORTED', 'REJECTED', 'PREEMPTING', 'RECALLING',
@@ -277,23 +283,17 @@ class RandomNavigation:
             distance = math.hypot(loc.x - position[0], loc.y - position[1])
             i += 1
             rospy.loginfo('Going to: %s%s', loc.name, ' (%s)' % loc.room if loc.room else '')
-            self.move_base.send_goal(self.goal(loc))
             self.goal_active = True
-            finished_within_time = self.move_base.wait_for_result(rospy.Duration(self.goal_timeout))
-            if rospy.is_shutdown():
+            state = self.pursue(loc)
+            if state is None:
                 break  # the shutdown hook cancels the goal; this one is not counted
-            if not finished_within_time:
-                self.move_base.cancel_goal()
-                state = 'TIMED_OUT'
+            if state == 'TIMED_OUT':
                 rospy.loginfo('Timed out achieving goal')
+            elif state == 'SUCCEEDED':
+                rospy.loginfo('Goal succeeded!')
+                rospy.loginfo('State:' + str(GoalStatus.SUCCEEDED))
             else:
-                code = self.move_base.get_state()
-                state = GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
-                if code == GoalStatus.SUCCEEDED:
-                    rospy.loginfo('Goal succeeded!')
-                    rospy.loginfo('State:' + str(code))
-                else:
-                    rospy.loginfo('Goal failed with error code: ' + state)
+                rospy.loginfo('Goal failed with error code: ' + state)
             self.goal_active = False
             self.tally.record(loc.name, state, distance)
             # Measured from where the robot was meant to be, as the tutorial does.
@@ -310,6 +310,58 @@ class RandomNavigation:
         if self.start_time is not None:
             rospy.loginfo(self.tally.summary(self.running_time(), self.locations))
         return 0
+
+    def server_silence(self) -> float:
+        """[s] of ROS time since move_base's last action status (inf before the first)."""
+        last = self.move_base.action_client.last_status_msg
+        return (rospy.Time.now() - last.header.stamp).to_sec() if last is not None else float('inf')
+
+    def pursue(self, loc: Location) -> Optional[str]:
+        """Sends the goal and waits for its end (goal_timeout); the state's name, or None at shutdown.
+
+        move_base killed mid-goal (and respawned by roslaunch) is noticed two ways: its status
+        stops (SERVER_SILENCE s), or the new process's status does not know the goal (actionlib
+        calls it LOST). Either way the same goal is sent again once move_base answers, at most
+        MAX_RESENDS times, so the count goes on; if it does not come back within server_timeout the
+        goal counts as LOST."""
+        deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
+        resends = 0
+        self.move_base.send_goal(self.goal(loc))
+        while not rospy.is_shutdown():
+            if self.move_base.wait_for_result(rospy.Duration(1.0)):
+                code = self.move_base.get_state()
+                if code != GoalStatus.LOST or resends >= MAX_RESENDS:
+                    return GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
+                why = 'lost the goal (it was restarted?)'
+            elif rospy.Time.now() > deadline:
+                self.move_base.cancel_goal()
+                return 'TIMED_OUT'
+            elif self.server_silence() > SERVER_SILENCE:
+                why = 'has sent no status for %.0f s (it died or hangs)' % self.server_silence()
+            else:
+                continue
+            if resends >= MAX_RESENDS:
+                return 'LOST'
+            rospy.logwarn('random_navigation: move_base (%s) %s during the goal to %s; waiting up to %g s '
+                          '(server_timeout) for it to answer, then sending the goal again',
+                          rospy.resolve_name('move_base'), why, loc.name, self.server_timeout)
+            if not self.move_base.wait_for_server(rospy.Duration(self.server_timeout)):
+                if rospy.is_shutdown():
+                    return None
+                rospy.logerr('random_navigation: move_base did not come back within %g s; the goal to %s counts '
+                             'as LOST', self.server_timeout, loc.name)
+                return 'LOST'
+            answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)
+            while self.server_silence() > SERVER_SILENCE and rospy.Time.now() < answer_by:
+                try:
+                    rospy.sleep(0.2)  # connected: wait for the new process's first status
+                except rospy.ROSInterruptException:
+                    return None
+            resends += 1
+            rospy.loginfo('random_navigation: move_base answers again; sending the goal to %s again', loc.name)
+            self.move_base.send_goal(self.goal(loc))
+            deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
+        return None
 
     def stop_robot(self) -> None:
         self.cmd_vel_pub.publish(Twist())
