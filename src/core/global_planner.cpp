@@ -143,8 +143,14 @@ Plan GlobalPlanner::makePlan(const Costmap& map, const Eigen::Vector2d& start_m,
   costs_ = &map.costs();
   const int start = static_cast<int>(map.index(s));
   start_ = start;
-  // The robot's own cell is passable even when inscribed (navfn clears the robot cell).
+  // The robot's own cell is passable even when inscribed (navfn clears the robot cell), and so are
+  // the inscribed cells near an inscribed start (kStartEscape_m), at the highest passable cost.
   start_cost_ = static_cast<float>(params_.neutral_cost);
+  map_width_ = map.width();
+  start_x_ = s.x;
+  start_y_ = s.y;
+  escape_cells_ = map.cost(s) == cost::kInscribed ? static_cast<int>(std::ceil(kStartEscape_m / map.resolution())) : 0;
+  escape_cost_ = cost_of_value_[cost::kInscribed - 1];
 
   int goal = static_cast<int>(map.index(g));
   if (!std::isfinite(cellCost(goal))) {
@@ -220,7 +226,8 @@ float GlobalPlanner::blockCost(int bx, int by) {
   for (int y = y0; y < y1; ++y) {
     const uint8_t* row = c + static_cast<std::size_t>(y) * w;
     for (int x = x0; x < x1; ++x) {
-      const float v = cost_of_value_[row[x]];
+      float v = cost_of_value_[row[x]];
+      if (escape_cells_ > 0 && !std::isfinite(v)) v = cellCost(y * w + x);
       if (std::isfinite(v)) {
         sum += v;
         ++passable;
@@ -307,7 +314,7 @@ bool GlobalPlanner::crossable(int bx, int by, int dx, int dy) const {
   const int w = width_;
   auto passable = [&](int x, int y) {
     const int i = y * w + x;
-    return i == start_ || std::isfinite(cost_of_value_[(*costs_)[i]]);
+    return std::isfinite(cellCost(i));
   };
   const int x0 = bx * kBlock, y0 = by * kBlock;
   if (dx != 0 && dy != 0) {

@@ -363,7 +363,29 @@ Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d&
   updateGrids(map, pose);
   if (shortcuts_) buildNonZeroTable(map);
   table_valid_ = shortcuts_;  // only for this call's map: scoreTrajectory may get another one
+  // A footprint that already touches a lethal cell where the robot stands (a wall end the costmap's
+  // cells round onto its outline, a person who walked up to it) makes every trajectory invalid,
+  // turning away included, and the robot would wait there for ever. This cycle is then planned with
+  // the largest shrunken footprint that is free where it stands: moves that go deeper in stay
+  // invalid, moves out are allowed, and the full footprint returns once it is clear.
+  const Footprint full = footprint_;
+  const double full_radius = circumscribed_;
+  footprint_scale_ = 1.0;
+  if (footprintCost(map, pose, footprint_, true) < 0) {
+    for (double scale : kEscapeScales) {
+      Footprint shrunk(full.size());
+      for (std::size_t i = 0; i < full.size(); ++i) shrunk[i] = scale * full[i];
+      if (footprintCost(map, pose, shrunk, true) >= 0) {
+        footprint_ = std::move(shrunk);
+        circumscribed_ = scale * full_radius;
+        footprint_scale_ = scale;
+        break;
+      }
+    }
+  }
   Trajectory best = createTrajectories(map, pose, velocity);
+  footprint_ = full;
+  circumscribed_ = full_radius;
   table_valid_ = false;
   if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;
   return best;

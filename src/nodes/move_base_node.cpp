@@ -436,6 +436,10 @@ class MoveBase {
         auto guard = local_->lock();
         control = controller_->compute(local_->master(), *local_pose, velocity());
       }
+      if (control.valid && control.footprint_scale < 1.0) {
+        ROS_WARN_THROTTLE(5, "move_base: the robot's footprint touches an obstacle in the local costmap where it stands; "
+                             "moving out with the footprint shrunk to %.0f%%", 100.0 * control.footprint_scale);
+      }
       if (controller_->reached()) {
         stop();
         controller_->reset();

@@ -77,6 +77,26 @@ TEST_P(BothPlanners, TypedFailures) {
   EXPECT_EQ(planner.makePlan(m, {-1.0, 2.5}, {1.5, 2.5}).status, PlanStatus::kStartOffMap);
 }
 
+TEST_P(BothPlanners, AStartInAnInscribedPocketLeavesItButNeverCrossesAWall) {
+  // A robot the costmap puts against a wall end (its centre inscribed, every neighbour inscribed):
+  // navfn clears only the robot's cell and finds no way out; here the inscribed cells within
+  // kStartEscape_m of the start are passable, lethal ones never.
+  Costmap m(60, 60, 0.05, {0, 0});
+  for (int y = 0; y < 60; ++y) m.setCost({30, y}, cost::kLethal);                 // wall at x = 1.5 m
+  for (int y = 0; y < 60; ++y)
+    for (int x = 26; x <= 34; ++x)
+      if (x != 30) m.setCost({x, y}, cost::kInscribed);                            // its inscribed band
+  PlannerParams p;
+  p.use_astar = GetParam();
+  GlobalPlanner planner(p);
+  const Plan out = planner.makePlan(m, {1.42, 1.5}, {0.5, 1.5});  // start inscribed, 0.07 m from the wall
+  ASSERT_EQ(out.status, PlanStatus::kOk) << out.message;
+  for (const auto& q : out.path) EXPECT_LT(q.x(), 1.5) << "crossed the wall";
+  // Away from the start the inscribed band still blocks: no goal inside it far along the wall.
+  const Plan along = planner.makePlan(m, {0.5, 0.5}, {1.4, 2.9});
+  EXPECT_NE(along.status, PlanStatus::kOk);
+}
+
 TEST_P(BothPlanners, GoalInAWallMovesWithinTheTolerance) {
   const Costmap m = wallMap();
   PlannerParams p;
@@ -174,7 +194,12 @@ TEST_P(BothPlanners, HierarchicalPlansMatchTheWholeMapSearch) {
     ASSERT_EQ(pa.status, pb.status) << "trial " << trial << ": " << pa.message << " / " << pb.message;
     if (pa.status != PlanStatus::kOk) continue;
     ++compared;
-    EXPECT_FALSE(touchesObstacle(m, {pa.path.begin() + 1, pa.path.end()}))
+    // Inscribed cells are passable near an inscribed start only (kStartEscape_m); lethal ones never.
+    std::vector<Eigen::Vector2d> beyond;
+    for (const auto& q : pa.path) {
+      if (m.cost(m.worldToCell(q)) == cost::kLethal || (q - s).norm() > GlobalPlanner::kStartEscape_m + 0.05) beyond.push_back(q);
+    }
+    EXPECT_FALSE(touchesObstacle(m, beyond))
         << "trial " << trial << " from " << s.transpose() << " (cost " << int(m.cost(m.worldToCell(s))) << ") to " << g.transpose()
         << "; the reference " << (touchesObstacle(m, {pb.path.begin() + 1, pb.path.end()}) ? "too" : "not");
     EXPECT_LE(pathLength(pa.path), 1.02 * pathLength(pb.path) + 1e-9) << "trial " << trial << " from " << s.transpose() << " to " << g.transpose();

@@ -157,18 +157,46 @@ TEST(LocalPlanner, ApproachesAGoalNearAWallInsteadOfSpinning) {
   EXPECT_GT(t.xv, 0.0) << "spinning on the spot although a forward move gets nearer the goal";
 }
 
+TEST(LocalPlanner, AFootprintAlreadyTouchingAWallMovesOutAndNeverDeeper) {
+  // A person walked up, or a wall end's cells round onto the outline: the robot stands with its
+  // outline on a lethal cell. Every trajectory with the full footprint is invalid, turning away
+  // included; the planner must still find a way out, and only away from the wall.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int y = 0; y < 100; ++y) raw.setCost({60, y}, cost::kLethal);  // wall cells x 3.00 .. 3.05
+  const Costmap m = inflated(raw);
+  const Footprint round = circleFootprint(0.2);
+  const Eigen::Vector3d pose(2.82, 2.5, M_PI);  // outline reaches 3.02: on the wall's cells
+  ASSERT_LT(footprintCost(m, pose, round), 0);
+  LocalPlanner lp(tutorialParams(), round);
+  lp.setPlan(straightPlan({2.82, 2.5}, {1.0, 2.5}));  // the way on is away from the wall
+  const Trajectory t = lp.findBestPath(m, pose, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0) << "frozen against the wall";
+  EXPECT_LT(lp.lastFootprintScale(), 1.0);
+  ASSERT_FALSE(t.points.empty());
+  EXPECT_LE(t.points.back().x(), pose.x() + 1e-9);  // never towards the wall
+  // The same robot clear of the wall plans with its whole footprint.
+  lp.findBestPath(m, {2.5, 2.5, M_PI}, {0, 0, 0});
+  EXPECT_EQ(lp.lastFootprintScale(), 1.0);
+}
+
 TEST(LocalPlanner, BoxedInGivesNoCommand) {
   Costmap m(100, 100, 0.05, {0, 0});
-  // A 0.5 m box of lethal cells around a 0.4 m robot: no turn, no back-up, no forward move.
+  // A 0.5 m box of lethal cells around a 0.4 m robot (x 2.30 .. 2.75 inside): no turn, no back-up,
+  // no forward move.
   for (int i = 40; i <= 60; ++i) {
     m.setCost({i, 40}, cost::kLethal);
     m.setCost({i, 50}, cost::kLethal);
     m.setCost({40, i}, cost::kLethal);
   }
-  for (int i = 40; i <= 50; ++i) m.setCost({45, i}, cost::kLethal);
+  for (int i = 40; i <= 50; ++i) {
+    m.setCost({45, i}, cost::kLethal);
+    m.setCost({55, i}, cost::kLethal);
+  }
   LocalPlanner lp(tutorialParams(), square());
-  lp.setPlan(straightPlan({2.5, 2.25}, {4.5, 2.25}));
-  const Trajectory t = lp.findBestPath(m, {2.5, 2.25, 0.0}, {0, 0, 0});
+  lp.setPlan(straightPlan({2.52, 2.26}, {4.5, 2.26}));
+  const Eigen::Vector3d pose(2.52, 2.26, 0.0);
+  ASSERT_GE(footprintCost(m, pose, square()), 0);  // boxed in, not touching
+  const Trajectory t = lp.findBestPath(m, pose, {0, 0, 0});
   EXPECT_LT(t.cost, 0.0);
   EXPECT_EQ(t.xv, 0.0);
   EXPECT_EQ(t.thetav, 0.0);

@@ -73,7 +73,17 @@ class GlobalPlanner {
 
  private:
   static constexpr float kUnreached = std::numeric_limits<float>::infinity();
-  float cellCost(int i) const { return i == start_ ? start_cost_ : cost_of_value_[(*costs_)[i]]; }
+  float cellCost(int i) const {
+    if (i == start_) return start_cost_;
+    const uint8_t c = (*costs_)[i];
+    const float v = cost_of_value_[c];
+    // A robot whose centre stands in an inscribed cell may leave through the inscribed cells around it.
+    if (escape_cells_ > 0 && c == cost::kInscribed && v == kUnreached) {
+      const int dx = i % map_width_ - start_x_, dy = i / map_width_ - start_y_;
+      if (dx * dx + dy * dy <= escape_cells_ * escape_cells_) return escape_cost_;
+    }
+    return v;
+  }
   /// A diagonal step (dx, dy both non-zero) from cell i must not cut the corner of an obstacle.
   bool cutsCorner(int i, int dx, int dy, int w) const {
     return dx != 0 && dy != 0 && (!std::isfinite(cellCost(i + dx)) || !std::isfinite(cellCost(i + dy * w)));
@@ -102,6 +112,10 @@ class GlobalPlanner {
 
  public:
   static constexpr int kBlock = 4;            ///< [cells] side of a coarse block
+  /// [m] A start in an inscribed cell (a robot the costmap puts against a wall end or a person who
+  /// walked up to it) may leave through inscribed cells this close to it; navfn clears only the
+  /// robot's own cell and then finds no way out of such a pocket.
+  static constexpr double kStartEscape_m = 0.3;
   static constexpr int kCorridorRadius = 3;   ///< [blocks] around the coarse way
 
  private:
@@ -109,6 +123,9 @@ class GlobalPlanner {
   float cost_of_value_[256];
   float start_cost_ = 0.0f;
   int start_ = -1;
+  // The start's inscribed surroundings (kStartEscape_m), passable only when the start is inscribed.
+  int escape_cells_ = 0, start_x_ = 0, start_y_ = 0, map_width_ = 1;
+  float escape_cost_ = 0.0f;
   const std::vector<uint8_t>* costs_ = nullptr;
   std::vector<float> value_;
   std::vector<uint32_t> stamp_;   // == generation_: value_ and the done flag are from this search

@@ -107,6 +107,10 @@ class LocalPlanner {
   LocalPlanner(const LocalPlannerParams& params, const Footprint& footprint);
   const LocalPlannerParams& params() const { return params_; }
   const Footprint& footprint() const { return footprint_; }
+  /// The footprint scale the last findBestPath used: 1, or less when the full footprint touched a
+  /// lethal cell where the robot stood and a shrunken one let it move out (kEscapeScales).
+  double lastFootprintScale() const { return footprint_scale_; }
+  static constexpr double kEscapeScales[] = {0.9, 0.8, 0.7, 0.6, 0.5};
 
   /// The global plan (costmap frame, pruned to start near the robot).
   void setPlan(const std::vector<Eigen::Vector2d>& plan);
@@ -168,6 +172,7 @@ class LocalPlanner {
   int table_w_ = 0, table_h_ = 0;
   bool table_valid_ = false, shortcuts_ = true;
   double circumscribed_ = 0.0;
+  double footprint_scale_ = 1.0;
   // ROS's oscillation suppression and escape state.
   bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
   bool rotating_left_ = false, rotating_right_ = false, strafe_left_ = false, strafe_right_ = false;

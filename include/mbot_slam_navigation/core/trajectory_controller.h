@@ -39,6 +39,7 @@ struct ControlResult {
   bool valid = false;
   Eigen::Vector3d command = Eigen::Vector3d::Zero();  ///< (vx, vy, vtheta)
   std::string why;                                    ///< why not, when !valid
+  double footprint_scale = 1.0;                       ///< < 1: moving out of an obstacle the footprint touched
 };
 
 class TrajectoryController {
