@@ -10,6 +10,11 @@ route (RouteDriver) and feeds odometry and scans to the same Localizer the amcl 
   at its true pose; position error of every estimate against ground truth.
 - global localization: the mbot in the home world (perfect map), particles over all free space,
   driving the home tour; time and distance until the estimate is within 0.2 m and stays there.
+- kidnap: the car tracking on maps/map.yaml is carried 3 m into the next room (as set_model_state
+  does) and drives on; how long until amcl says it is lost (FitMonitor, the node's warning), and
+  until the estimate is back within 0.3 m for good: with recovery_alpha_slow/fast 0.001/0.1 (ROS's
+  suggested values) amcl alone, and with amcl_diff.launch's 0/0 by global_localization called when
+  it says it is lost. Target (issue 19): recovered within 30 s simulated.
 Prints JSON result lines (see run_all.py) and writes bench/out/amcl_global.png (particles over the
 map at the start and when converged, and the path).
 """
@@ -211,6 +216,59 @@ def global_localization():
         draw(data, origin, *picture)
 
 
+def kidnap():
+    m = load_map(os.path.join(PKG, 'maps', 'map.yaml'))
+    settings = amcl_diff()[1]
+    carry_at, carry = 20.0, (3.0, 0.0)   # [s simulated], [m]: from the middle room into the right one
+    for label, overrides, relocalize in (('recovery_alpha 0.001/0.1', dict(recovery_alpha_slow=0.001,
+                                                                             recovery_alpha_fast=0.1), False),
+                                         ('amcl_diff.launch + global_localization when lost', {}, True)):
+        detected, recovered = [], []
+        for seed in range(3):
+            drive = Drive(os.path.join(PKG, 'worlds', 'wall.world'), os.path.join(PKG, 'urdf', 'myrobot.xacro'),
+                          (0.0, 0.0, 0.0), WALL_ROUTE * 2, seed=seed)
+            pf = make_pf(m.data, m.resolution, m.origin, seed=seed, **overrides)
+            pf.init_gaussian(np.zeros(3), np.diag([0.01, 0.01, 0.01]))
+            loc = Localizer(pf, settings['update_min_d'], settings['update_min_a'], settings['resample_interval'])
+            a0, inc, rmin, rmax, lxy = laser_args(drive)
+            carried = lost_at = back_at = None
+            for odom, ranges in drive.scans(max_time=carry_at + 180.0):
+                t = drive.sim.time
+                if carried is None and t >= carry_at:
+                    x, y, yaw = drive.robot.pose
+                    for dx in (carry[0], -carry[0]):  # into whichever neighbouring room is free
+                        try:
+                            drive.sim.set_pose('robot', (x + dx, y, yaw))
+                            if not drive.sim.geometry.overlaps(drive.robot.drive.footprint_in_world(), 0):
+                                break
+                        except Exception:  # noqa: BLE001
+                            continue
+                    carried = t
+                if not loc.update(odom, a0, inc, rmin, rmax, ranges, lxy):
+                    continue
+                if carried is None:
+                    continue
+                if loc.fit_change == 'lost' and lost_at is None:
+                    lost_at = t - carried
+                    if relocalize:
+                        pf.init_uniform()
+                        loc.reinitialized()
+                est, truth = loc.estimate()[0], drive.robot.pose
+                if math.hypot(est[0] - truth[0], est[1] - truth[1]) <= 0.3:
+                    back_at = back_at if back_at is not None else t - carried
+                else:
+                    back_at = None
+            detected.append(lost_at if lost_at is not None else math.inf)
+            recovered.append(back_at if back_at is not None else math.inf)
+            print('kidnap (%s) run %d: lost noticed after %s s, back within 0.3 m for good after %s s'
+                  % (label, seed, '%.1f' % lost_at if lost_at is not None else 'never',
+                     '%.1f' % back_at if back_at is not None else 'never'), flush=True)
+        emit('kidnap 3 m, %s: noticed after' % label, statistics.median(detected), 's (sim)', '',
+             'runs %s' % ', '.join('%.1f' % d for d in detected))
+        emit('kidnap 3 m, %s: recovered after' % label, statistics.median(recovered), 's (sim)', '<= 30',
+             'runs %s' % ', '.join('%.1f' % r for r in recovered))
+
+
 def draw(data, origin, start, converged, path):
     img = np.where(data >= 65, 0, np.where(data == 0, 255, 205)).astype(np.uint8)
     img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
@@ -230,6 +288,6 @@ def draw(data, origin, start, converged, path):
 
 
 if __name__ == '__main__':
-    which = sys.argv[1:] or ['update_time', 'tracking', 'tracking_ros_alphas', 'global_localization']
+    which = sys.argv[1:] or ['update_time', 'tracking', 'tracking_ros_alphas', 'global_localization', 'kidnap']
     for name in which:
         globals()[name]()

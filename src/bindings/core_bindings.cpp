@@ -148,6 +148,8 @@ PYBIND11_MODULE(_core, m) {
            },
            "(N, 4) array: x, y, yaw, weight")
       .def_property_readonly("w_slow", &Amcl::wSlow)
+      .def_property_readonly("last_average_weight", &Amcl::lastAverageWeight)
+      .def_property_readonly("last_scan_fit", &Amcl::lastScanFit)
       .def_property_readonly("w_fast", &Amcl::wFast)
       .def("resample_limit", &Amcl::resampleLimit);
 

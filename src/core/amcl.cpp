@@ -325,10 +325,36 @@ int Amcl::sensorUpdate(const LaserScan& scan, const Eigen::Vector3d& laser_pose)
     }
   }
 
+  // How well the scan fits at the heaviest particle: the share of returns within kFitTolerance of
+  // an occupied cell. The mean weight moves little when the robot is carried to a place that looks
+  // alike; this share falls to about a half and is what FitMonitor (nav/localizer.py) watches.
+  {
+    const AmclParticle* best = &particles_.front();
+    for (const auto& p : particles_) {
+      if (p.weight > best->weight) best = &p;
+    }
+    const Eigen::Vector3d lp = composePose(best->pose, laser_pose);
+    const auto& dist = map_->occupiedDistance(a.likelihood_max_dist);
+    int returns = 0, fitting = 0;
+    for (const auto& b : beams) {
+      if (b.range >= range_max) continue;
+      const double x = lp.x() + b.range * std::cos(lp.z() + b.bearing), y = lp.y() + b.range * std::sin(lp.z() + b.bearing);
+      const int cx = static_cast<int>(std::floor((x - map_->origin().x()) / map_->resolution()));
+      const int cy = static_cast<int>(std::floor((y - map_->origin().y()) / map_->resolution()));
+      ++returns;
+      if (cx >= 0 && cy >= 0 && cx < map_->width() && cy < map_->height() &&
+          dist[static_cast<std::size_t>(cy) * map_->width() + cx] <= kFitTolerance) {
+        ++fitting;
+      }
+    }
+    scan_fit_ = returns > 0 ? static_cast<double>(fitting) / returns : -1.0;
+  }
+
   // Recovery averages track the mean (unnormalized) weight, as ROS's pf_update_sensor.
   double total = 0.0;
   for (const auto& p : particles_) total += p.weight;
   const double w_avg = total / static_cast<double>(particles_.size());
+  w_avg_ = w_avg;
   if (w_avg > 0.0 && std::isfinite(w_avg)) {
     w_slow_ = w_slow_ == 0.0 ? w_avg : w_slow_ + a.recovery_alpha_slow * (w_avg - w_slow_);
     w_fast_ = w_fast_ == 0.0 ? w_avg : w_fast_ + a.recovery_alpha_fast * (w_avg - w_fast_);

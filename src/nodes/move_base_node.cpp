@@ -331,6 +331,7 @@ class MoveBase {
 
   void reset() {
     const ros::Time now = ros::Time::now();
+    last_cycle_time_ = now;
     state_ = State::kPlanning;
     plan_.clear();
     new_plan_ = false;
@@ -356,6 +357,16 @@ class MoveBase {
   /// One control cycle; true when the goal is finished (succeeded or aborted).
   bool cycle(const Vec3& goal) {
     const ros::Time now = ros::Time::now();
+    if (!last_cycle_time_.isZero() && now + ros::Duration(1.0) < last_cycle_time_) {
+      // reset_simulation (or a bag played again): the pose, plan and obstacles of before no longer hold.
+      const double back = (last_cycle_time_ - now).toSec();
+      last_cycle_time_ = ros::Time();
+      global_->resetLayers();
+      local_->resetLayers();
+      return abort(fmt("the clock went back by %.1f s (the simulation was reset?); the costmaps are cleared, send the "
+                       "goal again", back));
+    }
+    last_cycle_time_ = now;
     const auto pose = global_->lookupRobotPose();
     if (!pose) {
       stop();
@@ -638,6 +649,7 @@ class MoveBase {
   Path2 plan_;
   bool new_plan_ = false;
   ros::Time last_plan_time_, last_valid_plan_, last_valid_control_, last_oscillation_reset_;
+  ros::Time last_cycle_time_;  // of the goal loop, to notice the clock going back
   std::optional<Vec3> oscillation_pose_;
   int planning_retries_ = 0;
   std::size_t recovery_index_ = 0;

@@ -185,7 +185,8 @@ class SlamGmappingNode {
       return;
     }
     if (!last_stamp_.isZero() && msg->header.stamp + ros::Duration(1.0) < last_stamp_) {
-      ROS_WARN("slam_gmapping: time went backwards (scan at %.3f after %.3f; a bag restarted?): resetting the map",
+      ROS_WARN("slam_gmapping: time went backwards (scan at %.3f after %.3f; the simulation reset or a bag restarted?): "
+               "starting a new map",
                msg->header.stamp.toSec(), last_stamp_.toSec());
       std::lock_guard<std::mutex> lock(mutex_);
       slam_.reset();
@@ -195,6 +196,7 @@ class SlamGmappingNode {
       loop_stamps_.clear();
       scan_stamps_.clear();
       last_scan_tf_stamp_ = ros::Time();
+      last_map_update_ = ros::Time();  // else no map until the clock passes the old update again
       first_transform_ = true;
     }
     last_stamp_ = msg->header.stamp;
@@ -229,7 +231,7 @@ class SlamGmappingNode {
         ros::shutdown();
         return;
       }
-      ROS_INFO("slam_gmapping: %s backend%s, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
+      ROS_INFO("slam_gmapping: starting a new map: %s backend%s, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
                backend_.c_str(), backend_ == "rbpf" ? (" with " + std::to_string(params.particles) + " particles").c_str() : "",
                params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
                base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);

@@ -89,6 +89,40 @@ def test_localizer_updates_on_motion_thresholds_and_resamples_every_interval():
     assert back == pytest.approx(est)
 
 
+def test_fit_monitor_says_lost_when_the_fit_falls_and_found_when_it_returns_never_on_noise():
+    from mbot_slam_navigation.nav.localizer import FitMonitor
+    rng = np.random.default_rng(3)
+    m = FitMonitor()
+    changes = [m.add(float(np.clip(rng.normal(0.93, 0.04), 0, 1))) for _ in range(300)]  # tracking, with noise
+    assert not any(changes)
+    after = [m.add(f) for f in (0.55, 0.6, 0.5, 0.55, 0.5)]     # carried: about half the returns fit
+    assert 'lost' in after  # within five updates (the quick average falls, then three updates below)
+    assert m.lost and m.ratio() < FitMonitor.LOST_RATIO
+    held = m.slow
+    assert [m.add(0.5) for _ in range(50)] == [None] * 50 and m.slow == held  # the good level is kept
+    back = [m.add(0.92) for _ in range(5)]
+    assert 'found' in back and not m.lost
+
+
+def test_the_filter_reports_a_scan_fit_that_falls_when_the_robot_is_elsewhere():
+    """Amcl::lastScanFit: the share of returns near a wall, seen from the heaviest particle."""
+    data = np.zeros((60, 60), np.int8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100   # a 6 m box, walls at 0.05 and 5.95 m
+    p = _core._AmclParams()
+    p.min_particles = p.max_particles = 100
+    pf = _core._Amcl(p, 1)
+    pf.set_map(_core._AmclMap(data, 0.1, (0.0, 0.0)))
+    pf.init_gaussian(np.array([3.0, 3.0, 0.0]), np.diag([1e-6, 1e-6, 1e-6]))
+    angles = -math.pi + np.arange(90) * 2 * math.pi / 90
+    box = lambda x, y: np.array([min(((5.95 - x) if math.cos(a) > 0 else (x - 0.05)) / max(abs(math.cos(a)), 1e-9),  # noqa: E731
+                                     ((5.95 - y) if math.sin(a) > 0 else (y - 0.05)) / max(abs(math.sin(a)), 1e-9))
+                                 for a in angles], np.float32)
+    pf.sensor_update(-math.pi, 2 * math.pi / 90, 0.1, 8.0, box(3.0, 3.0), np.zeros(3))
+    assert pf.last_scan_fit > 0.9
+    pf.sensor_update(-math.pi, 2 * math.pi / 90, 0.1, 8.0, box(1.0, 4.5), np.zeros(3))  # taken elsewhere
+    assert pf.last_scan_fit < 0.5
+
+
 def test_launch_file_names_are_unique_so_roslaunch_by_name_works():
     # `roslaunch mbot_slam_navigation move_base.launch` (the tutorial's command) fails when two files
     # in the package share the name.

@@ -128,6 +128,12 @@ class Amcl {
   /// Recovery averages of the total likelihood (ROS's w_slow, w_fast).
   double wSlow() const { return w_slow_; }
   double wFast() const { return w_fast_; }
+  /// The mean unnormalized particle weight of the last sensorUpdate (what w_slow and w_fast average).
+  double lastAverageWeight() const { return w_avg_; }
+  /// The share of the last scan's returns (beams in use, below range_max) that end within
+  /// kFitTolerance of an occupied cell seen from the heaviest particle; -1 without returns.
+  double lastScanFit() const { return scan_fit_; }
+  static constexpr double kFitTolerance = 0.2;  ///< [m]
   /// ROS's pf_resample_limit: the particle count KLD-sampling asks for with k occupied bins.
   int resampleLimit(int k) const;
 
@@ -141,6 +147,8 @@ class Amcl {
   std::vector<AmclParticle> particles_;
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;
+  double w_avg_ = 0.0;
+  double scan_fit_ = -1.0;
   // The likelihood field as pz^3 per cell for the last (params, range_max): one lookup per beam.
   std::vector<float> field_;
   float field_outside_ = 0.0f;

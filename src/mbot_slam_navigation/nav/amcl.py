@@ -322,7 +322,24 @@ class AmclNode:
             if self.loc.update(pose, angle_min, increment, range_min, range_max, scan.ranges, (lx, ly)):
                 self.publish_estimate(scan.header.stamp)
                 self.publish_cloud(scan.header.stamp)
+                self.report_fit()
             self.send_transform(scan.header.stamp)
+
+    def report_fit(self):
+        """One line when the scans stop fitting the map around the estimate, and one when they fit again."""
+        change = self.loc.fit_change
+        if change is None:
+            return
+        x, y, _ = self.last_estimate
+        if change == 'lost':
+            recovering = self.params.recovery_alpha_slow > 0 and self.params.recovery_alpha_fast > 0
+            rospy.logwarn('amcl: the scans fit the map at %.0f%% of before around the estimate (%.2f, %.2f): '
+                          'the robot may have been carried elsewhere; %s', 100.0 * self.loc.fit.ratio(), x, y,
+                          'recovery_alpha_slow/fast are set, so random particles are being injected'
+                          if recovering else 'recovery_alpha_slow/fast are 0, so amcl will not find it by itself: '
+                          'call the global_localization service or give a 2D Pose Estimate')
+        else:
+            rospy.loginfo('amcl: the scans fit the map again around (%.2f, %.2f)', x, y)
 
     # ------------------------------------------------------------------------------------ outputs
     def publish_estimate(self, stamp):

@@ -6,6 +6,7 @@ than update_min_a, since the last update (or once a no-motion update was request
 resample_interval-th update resamples. Poses are (x [m], y [m], yaw [rad]): odometry poses are the
 base in the odom frame, the estimate the base in the map frame.
 """
+from dataclasses import dataclass
 from typing import Optional, Tuple
 
 import numpy as np
@@ -13,6 +14,52 @@ import numpy as np
 from mbot_slam_navigation.transforms import compose2d, inverse2d, normalize_angle
 
 Pose = Tuple[float, float, float]
+
+
+@dataclass
+class FitMonitor:
+    """Notices when the scans stop fitting the map around the estimate (the robot carried elsewhere,
+    'kidnapped'), whether or not recovery_alpha_* lets amcl recover by itself.
+
+    Each update's scan fit (the share of returns near the map's walls at the heaviest particle,
+    Amcl::lastScanFit) is averaged slowly (over ~50 updates) and quickly (over ~2); the robot counts
+    as lost once the quick average has stayed below LOST_RATIO of the slow one for LOST_UPDATES
+    updates, and found again above FOUND_RATIO of it. While lost the slow average is held, so that it
+    keeps the level of a good fit to compare with."""
+    SLOW_ALPHA = 0.02
+    FAST_ALPHA = 0.5
+    WARM_UP = 10          # updates before any judgement
+    LOST_RATIO = 0.7
+    FOUND_RATIO = 0.85
+    LOST_UPDATES = 3
+    slow: float = 0.0
+    fast: float = 0.0
+    updates: int = 0
+    below: int = 0
+    lost: bool = False
+
+    def add(self, fit: float) -> Optional[str]:
+        """Feeds one update's mean weight; returns 'lost' or 'found' when that changes, else None."""
+        if not fit > 0.0:
+            return None
+        self.updates += 1
+        self.fast = fit if self.updates == 1 else self.fast + self.FAST_ALPHA * (fit - self.fast)
+        if not self.lost:
+            self.slow = fit if self.updates == 1 else self.slow + self.SLOW_ALPHA * (fit - self.slow)
+        if self.updates < self.WARM_UP:
+            return None
+        if not self.lost:
+            self.below = self.below + 1 if self.fast < self.LOST_RATIO * self.slow else 0
+            if self.below >= self.LOST_UPDATES:
+                self.lost = True
+                return 'lost'
+        elif self.fast > self.FOUND_RATIO * self.slow:
+            self.lost, self.below = False, 0
+            return 'found'
+        return None
+
+    def ratio(self) -> float:
+        return self.fast / self.slow if self.slow > 0 else 1.0
 
 
 class Localizer:
@@ -23,6 +70,8 @@ class Localizer:
         self.odom_at_update: Optional[Pose] = None
         self.force_update = False
         self.updates = 0
+        self.fit = FitMonitor()
+        self.fit_change: Optional[str] = None  # 'lost' or 'found' at the last update, else None
 
     def reinitialized(self) -> None:
         """The particles were replaced (initial pose, global localization, new map)."""
@@ -47,6 +96,7 @@ class Localizer:
         self.pf.sensor_update(angle_min, angle_increment, range_min, range_max, np.asarray(ranges, np.float32),
                               np.array([laser_xy[0], laser_xy[1], 0.0]))
         self.odom_at_update = tuple(odom)
+        self.fit_change = self.fit.add(self.pf.last_scan_fit)
         self.updates += 1
         if self.updates % self.resample_interval == 0:
             self.pf.resample()

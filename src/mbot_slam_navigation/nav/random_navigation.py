@@ -303,6 +303,8 @@ class RandomNavigation:
             if not self.limit_reached():
                 try:
                     rospy.sleep(self.rest_time)
+                except rospy.ROSTimeMovedBackwardsException:
+                    rospy.logwarn('random_navigation: the clock went back (the simulation was reset?); going on')
                 except rospy.ROSInterruptException:
                     break
         if self.start_time is not None and not rospy.is_shutdown():
