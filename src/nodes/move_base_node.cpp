@@ -86,7 +86,7 @@ class MoveBase {
   MoveBase()
       : tf_(ros::Duration(30.0)),
         listener_(tf_),
-        server_(nh_, "move_base", [this](const move_base_msgs::MoveBaseGoalConstPtr& g) { execute(g); }, false) {
+        server_(makeServer()) {
     ros::NodeHandle pnh("~");
     if (ros::Time::isSimTime()) heartbeat_pub_ = nh_.advertise<std_msgs::Header>("/sim_heartbeat", 10);
     auto beat = [this](const ros::Time& stamp) { beatHeartbeat(stamp); };
@@ -116,7 +116,8 @@ class MoveBase {
       global_->stop();
       local_->stop();
     }
-    server_.start();
+    server_->start();
+    clock_watch_ = nh_.createSteadyTimer(ros::WallDuration(0.2), [this](const ros::SteadyTimerEvent&) { watchClock(); });
     std::string recoveries;
     for (const auto& r : config_.recoveries) recoveries += (recoveries.empty() ? "" : ", ") + r.name;
     ROS_INFO("move_base ready: global planner %s (%s), local planner %s%s, recoveries %s", config_.global_type.c_str(),
@@ -278,7 +279,7 @@ class MoveBase {
     std::string why;
     const auto goal = inFrame(target, global_->config().global_frame, why);
     if (!goal) {
-      server_.setAborted(move_base_msgs::MoveBaseResult(),
+      server_->setAborted(move_base_msgs::MoveBaseResult(),
                          "Aborting on goal because it was sent with an invalid quaternion or frame: " + why);
       ROS_ERROR("move_base: goal rejected: %s", why.c_str());
       return std::nullopt;
@@ -301,9 +302,9 @@ class MoveBase {
     reset();
     SimRate rate(config_.controller_frequency);
     while (ros::ok()) {
-      if (server_.isPreemptRequested()) {
-        if (server_.isNewGoalAvailable()) {
-          const auto next = server_.acceptNewGoal();
+      if (server_->isPreemptRequested()) {
+        if (server_->isNewGoalAvailable()) {
+          const auto next = server_->acceptNewGoal();
           goal = accept(next->target_pose);
           if (!goal) {
             stop();
@@ -313,7 +314,7 @@ class MoveBase {
         } else {
           stop();
           controller_->reset();
-          server_.setPreempted(move_base_msgs::MoveBaseResult(), "Goal canceled");
+          server_->setPreempted(move_base_msgs::MoveBaseResult(), "Goal canceled");
           ROS_INFO("move_base: goal canceled; the robot is stopped");
           break;
         }
@@ -326,7 +327,7 @@ class MoveBase {
       local_->stop();
     }
     stop();
-    if (server_.isActive()) server_.setAborted(move_base_msgs::MoveBaseResult(), "move_base is shutting down");
+    if (server_->isActive()) server_->setAborted(move_base_msgs::MoveBaseResult(), "move_base is shutting down");
   }
 
   void reset() {
@@ -348,7 +349,7 @@ class MoveBase {
   bool abort(const std::string& text) {
     stop();
     ROS_ERROR("move_base: aborting the goal: %s", text.c_str());
-    server_.setAborted(move_base_msgs::MoveBaseResult(), text);
+    server_->setAborted(move_base_msgs::MoveBaseResult(), text);
     return true;
   }
 
@@ -382,7 +383,7 @@ class MoveBase {
     header.frame_id = global_->config().global_frame;
     header.stamp = now;
     feedback.base_position = poseStamped(header, pose->x(), pose->y(), pose->z());
-    server_.publishFeedback(feedback);
+    server_->publishFeedback(feedback);
 
     if (!oscillation_pose_ || (pose->head<2>() - oscillation_pose_->head<2>()).norm() >= config_.oscillation_distance) {
       last_oscillation_reset_ = now;
@@ -454,7 +455,7 @@ class MoveBase {
       if (controller_->reached()) {
         stop();
         controller_->reset();
-        server_.setSucceeded(move_base_msgs::MoveBaseResult(), "Goal reached.");
+        server_->setSucceeded(move_base_msgs::MoveBaseResult(), "Goal reached.");
         ROS_INFO("move_base: goal reached");
         return true;
       }
@@ -585,7 +586,7 @@ class MoveBase {
     if (!start) return;
     double turned = 0.0, last_yaw = start->z();
     const double tolerance = 0.1;
-    while (ros::ok() && !server_.isPreemptRequested()) {
+    while (ros::ok() && !server_->isPreemptRequested()) {
       const auto pose = local_->lookupRobotPose();
       if (!pose) break;
       turned += std::abs(std::remainder(pose->z() - last_yaw, 2 * M_PI));
@@ -612,7 +613,7 @@ class MoveBase {
     SimRate rate(cfg.frequency);
     const auto start = local_->lookupRobotPose();
     if (!start) return;
-    while (ros::ok() && !server_.isPreemptRequested()) {
+    while (ros::ok() && !server_->isPreemptRequested()) {
       const auto pose = local_->lookupRobotPose();
       if (!pose) break;
       const double moved = (pose->head<2>() - start->head<2>()).norm();
@@ -633,7 +634,38 @@ class MoveBase {
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_;
   tf2_ros::TransformListener listener_;
-  actionlib::SimpleActionServer<move_base_msgs::MoveBaseAction> server_;
+  using Server = actionlib::SimpleActionServer<move_base_msgs::MoveBaseAction>;
+  std::unique_ptr<Server> makeServer() {
+    return std::make_unique<Server>(nh_, "move_base", [this](const move_base_msgs::MoveBaseGoalConstPtr& g) {
+      executing_ = true;
+      execute(g);
+      executing_ = false;
+    }, false);
+  }
+
+  /// After the clock goes back (reset_simulation), actionlib's server would refuse every new goal:
+  /// their stamps are older than its last one ("canceled because another goal was recieved"). It
+  /// is started afresh once no goal runs (an active one is aborted by cycle()), and the costmaps
+  /// are cleared.
+  void watchClock() {
+    const ros::Time now = ros::Time::now();
+    if (!clock_seen_.isZero() && now + ros::Duration(1.0) < clock_seen_) server_reset_pending_ = true;
+    clock_seen_ = now;
+    if (!server_reset_pending_ || executing_) return;
+    server_reset_pending_ = false;
+    server_.reset();
+    server_ = makeServer();
+    server_->start();
+    global_->resetLayers();
+    local_->resetLayers();
+    ROS_WARN("move_base: the clock went back (the simulation was reset?): the costmaps are cleared and the action "
+             "server started afresh, so goals sent from now on are taken");
+  }
+
+  std::unique_ptr<Server> server_;
+  ros::SteadyTimer clock_watch_;
+  ros::Time clock_seen_;
+  std::atomic<bool> executing_{false}, server_reset_pending_{false};
   std::unique_ptr<ros_glue::CostmapROS> global_, local_;
   core::MoveBaseConfig config_;
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;

@@ -59,7 +59,7 @@ class NavigationFaultsTest(unittest.TestCase):
         cls.scan_pub = rospy.Publisher('/scan', LaserScan, queue_size=5)
         rospy.Subscriber('/scan_raw', LaserScan, cls.relay, queue_size=5)
         rospy.Subscriber('/base_pose_ground_truth', Odometry, cls.on_truth, queue_size=10)
-        rospy.Subscriber('/rosout_agg', Log, cls.on_log, queue_size=200)
+        rospy.Subscriber('/rosout', Log, cls.on_log, queue_size=200)  # every node's lines, as rqt_console reads them
         cls.client = SimpleActionClient('move_base', MoveBaseAction)
         assert cls.client.wait_for_server(rospy.Duration(120.0)), 'no move_base action server'
         rospy.wait_for_message('/map', OccupancyGrid, timeout=120.0)
