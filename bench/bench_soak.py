@@ -36,7 +36,7 @@ os.environ['ROS_MASTER_URI'] = 'http://localhost:%d' % PORT
 import rosgraph  # noqa: E402  (after ROS_MASTER_URI is set for this process)
 import rospy  # noqa: E402
 
-from mbot_slam_navigation.exploration_run import node_pids, stop  # noqa: E402
+from mbot_slam_navigation.exploration_run import node_cpu_seconds, node_pids, stop  # noqa: E402
 from mbot_slam_navigation.explore_report import draw_curves  # noqa: E402
 from mbot_slam_navigation.msg import Contact  # noqa: E402
 
@@ -154,6 +154,9 @@ def main():
         sim_end, wall_end = rospy.get_time(), time.monotonic() - wall0
         master = rosgraph.Master('/bench_soak')
         answered = {name: ping('/' + name, master) for name in sorted(pids)}
+        cpu = {}
+        for launch in launches:
+            cpu.update(node_cpu_seconds(launch.pid))
     finally:
         if nav is not None:
             stop(nav, 10.0)
@@ -181,6 +184,7 @@ def main():
                                                  'points': {k: list(v) for k, v in summary[2].items()}},
         'contacts': dict(kinds), 'memory': growth, 'restarts': dict(restarts), 'not_running_at_end': sorted(gone),
         'answered_at_end': answered,
+        'cpu_s_per_simulated_s': {k: round(v / max(sim_end, 1e-9), 4) for k, v in cpu.items()},
     }
     tmp = os.path.join(out, 'report.json.tmp')
     with open(tmp, 'w') as f:
@@ -204,7 +208,20 @@ def main():
               % (name, g['at_10_min_mb'], g['end_mb'], 100 * g['growth'], g['max_mb']))
     print('  restarts: %s; not running at the end: %s; answering at the end: %d/%d'
           % (dict(restarts) or 'none', sorted(gone) or 'none', sum(answered.values()), len(answered)))
+    print('  CPU s per simulated s: %s' % ', '.join('%s %.3f' % kv for kv in sorted(report['cpu_s_per_simulated_s'].items())))
     print('  report %s, memory picture %s' % (os.path.join(out, 'report.json'), os.path.join(out, 'memory.png')))
+    emit = lambda metric, value, unit, target='', note='': print(json.dumps(  # noqa: E731  (run_all.py's rows)
+        {'benchmark': 'soak', 'metric': metric, 'value': value, 'unit': unit, 'target': target, 'note': note}), flush=True)
+    if summary:
+        emit('goals reached, home with people', 100.0 * summary[1] / max(summary[0], 1), '%', '>= 98',
+             '%d of %d goals, %.0f s simulated' % (summary[1], summary[0], sim_end))
+    emit('collisions with walls or furniture', kinds.get('world', 0), '', '0')
+    emit('collisions the robot drove into a person', kinds.get('person (robot at fault)', 0), '', '0',
+         '%d people walked into the robot' % kinds.get('person (walked into the robot)', 0))
+    if growth:
+        worst = max(growth, key=lambda k: growth[k]['growth'])
+        emit('memory growth after 10 min, worst node', 100.0 * growth[worst]['growth'], '%', '< 10', worst)
+    emit('node restarts', sum(restarts.values()), '', '0', 'not running at the end: %s' % (sorted(gone) or 'none'))
     return 0 if finished else 1
 
 
