@@ -150,3 +150,21 @@ def test_people_reset_with_the_simulation_and_bad_scripts_name_the_line():
         sim.set_pose('walker', (0.0, 0.0, 0.0))
     with pytest.raises(SimulationError, match='exists already'):
         sim.add_person(sim.people['walker'].actor)
+
+
+def test_a_person_added_later_starts_its_script_then_and_again_after_a_reset():
+    sim = Simulation(load_world(HOME), slip_stddev=0.0)
+    for _ in range(500):
+        sim.step()                                    # 5 s in
+    sim.add_person(people_world().actors[0])          # delay_start 1 s: walks from 6 s on
+    p = sim.people['walker']
+    while sim.time < 5.9:
+        sim.step()
+    assert p.pose[0] == pytest.approx(-4.0)
+    while sim.time < 8.0:
+        sim.step()
+    assert p.pose[0] == pytest.approx(-2.0, abs=0.02)  # 2 s of walking at 1 m/s
+    sim.reset()
+    while sim.time < 3.0:
+        sim.step()
+    assert p.pose[0] == pytest.approx(-2.0, abs=0.02)  # after a reset it counts from 0, as the world's do

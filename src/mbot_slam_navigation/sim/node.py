@@ -176,8 +176,7 @@ class SimNode:
                 actors[0].name = req.model_name
             with self.lock:
                 for a in actors:
-                    a.delay_start += self.sim.time  # its script starts now
-                    self.sim.add_person(a)
+                    self.sim.add_person(a)  # its script (and delay_start) counts from now
         except (XmlError, SimulationError, ValueError) as e:
             rospy.logerr('gazebo_sim: cannot spawn "%s": %s', req.model_name, e)
             return SpawnModelResponse(False, 'SpawnModel: %s' % e)

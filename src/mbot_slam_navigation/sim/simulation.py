@@ -32,6 +32,7 @@ class Person:
     script_time: float = 0.0          # [s] of its script played (stops while it yields)
     waited: float = 0.0               # [s] yielding so far, without a step
     pose: Pose2D = (0.0, 0.0, 0.0)
+    added_at: float = 0.0             # [s] simulated time it came in (0 for the world's, and after a reset)
 
     @property
     def name(self) -> str:
@@ -114,7 +115,7 @@ class Simulation:
             raise SimulationError('a model named "%s" exists already' % actor.name)
         if not actor.radius > 0:
             raise SimulationError('person "%s": radius must be positive, got %r' % (actor.name, actor.radius))
-        person = Person(actor, pose=actor.pose_at(0.0))
+        person = Person(actor, pose=actor.pose_at(0.0), added_at=self.time)
         self.people[actor.name] = person
         self._update_people()
         return person
@@ -187,7 +188,7 @@ class Simulation:
             for l in r.lasers:
                 l.next_time = 0.0
         for p in self.people.values():
-            p.script_time, p.waited, p.pose = 0.0, 0.0, p.actor.pose_at(0.0)
+            p.script_time, p.waited, p.pose, p.added_at = 0.0, 0.0, p.actor.pose_at(0.0), 0.0
         self.steps = 0
         self._update_dynamic()
         self._update_people()
@@ -225,7 +226,7 @@ class Simulation:
         walked_into = {}
         for p in self.people.values():
             a = p.actor
-            if now < a.delay_start or not a.waypoints:
+            if now < p.added_at + a.delay_start or not a.waypoints:
                 continue
             nx, ny, nyaw = a.pose_at(p.script_time + dt)
             ahead = self.geometry.distance_to_dynamic_polygons(np.array([nx, ny]))
