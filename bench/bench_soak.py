@@ -22,6 +22,7 @@ node deaths. Run inside the devel environment (make bench does that).
 import json
 import os
 import re
+import socket
 import subprocess
 import sys
 import time
@@ -61,15 +62,9 @@ def rss_mb(pid):
 def ping(node_name, master):
     """True if the node answers getPid over XML-RPC within 5 s (rosnode ping)."""
     try:
-        uri = master.lookupNode(node_name)
-        proxy = xmlrpc.client.ServerProxy(uri)
-        import socket
-        old = socket.getdefaulttimeout()
-        socket.setdefaulttimeout(5.0)
-        try:
-            code, _, _ = proxy.getPid('/bench_soak')
-        finally:
-            socket.setdefaulttimeout(old)
+        proxy = xmlrpc.client.ServerProxy(master.lookupNode(node_name))
+        socket.setdefaulttimeout(5.0)  # this process's only XML-RPC calls from here on are pings
+        code, _, _ = proxy.getPid('/bench_soak')
         return code == 1
     except Exception:  # noqa: BLE001  (any failure is "does not answer")
         return False

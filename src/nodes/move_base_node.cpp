@@ -332,7 +332,6 @@ class MoveBase {
 
   void reset() {
     const ros::Time now = ros::Time::now();
-    last_cycle_time_ = now;
     state_ = State::kPlanning;
     plan_.clear();
     new_plan_ = false;
@@ -358,16 +357,12 @@ class MoveBase {
   /// One control cycle; true when the goal is finished (succeeded or aborted).
   bool cycle(const Vec3& goal) {
     const ros::Time now = ros::Time::now();
-    if (!last_cycle_time_.isZero() && now + ros::Duration(1.0) < last_cycle_time_) {
-      // reset_simulation (or a bag played again): the pose, plan and obstacles of before no longer hold.
-      const double back = (last_cycle_time_ - now).toSec();
-      last_cycle_time_ = ros::Time();
-      global_->resetLayers();
-      local_->resetLayers();
+    if (server_reset_pending_) {
+      // reset_simulation (or a bag played again): the pose, plan and obstacles of before no longer
+      // hold. watchClock() clears the costmaps and restarts the server once this goal has ended.
       return abort(fmt("the clock went back by %.1f s (the simulation was reset?); the costmaps are cleared, send the "
-                       "goal again", back));
+                       "goal again", clock_jump_s_.load()));
     }
-    last_cycle_time_ = now;
     const auto pose = global_->lookupRobotPose();
     if (!pose) {
       stop();
@@ -646,10 +641,13 @@ class MoveBase {
   /// After the clock goes back (reset_simulation), actionlib's server would refuse every new goal:
   /// their stamps are older than its last one ("canceled because another goal was recieved"). It
   /// is started afresh once no goal runs (an active one is aborted by cycle()), and the costmaps
-  /// are cleared.
+  /// are cleared. The one place that watches the clock; cycle() reads server_reset_pending_.
   void watchClock() {
     const ros::Time now = ros::Time::now();
-    if (!clock_seen_.isZero() && now + ros::Duration(1.0) < clock_seen_) server_reset_pending_ = true;
+    if (!clock_seen_.isZero() && now + ros::Duration(1.0) < clock_seen_) {
+      clock_jump_s_ = (clock_seen_ - now).toSec();
+      server_reset_pending_ = true;
+    }
     clock_seen_ = now;
     if (!server_reset_pending_ || executing_) return;
     server_reset_pending_ = false;
@@ -666,6 +664,7 @@ class MoveBase {
   ros::SteadyTimer clock_watch_;
   ros::Time clock_seen_;
   std::atomic<bool> executing_{false}, server_reset_pending_{false};
+  std::atomic<double> clock_jump_s_{0.0};  // [s] how far the clock went back, for the abort text
   std::unique_ptr<ros_glue::CostmapROS> global_, local_;
   core::MoveBaseConfig config_;
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
@@ -681,7 +680,6 @@ class MoveBase {
   Path2 plan_;
   bool new_plan_ = false;
   ros::Time last_plan_time_, last_valid_plan_, last_valid_control_, last_oscillation_reset_;
-  ros::Time last_cycle_time_;  // of the goal loop, to notice the clock going back
   std::optional<Vec3> oscillation_pose_;
   int planning_retries_ = 0;
   std::size_t recovery_index_ = 0;

@@ -7,8 +7,8 @@ left the robot.
 
 1. The laser silent for 5 s during a goal: move_base stops the robot and says "sensor data is out of
    date" naming /scan; when scans return it goes on and reaches the goal.
-2. A person standing on the goal: the goal is aborted after planner_patience with the reason; sent
-   again and the person leaves, it is reached.
+2. A (slim) person standing on the goal: the goal is aborted after planner_patience with the
+   reason; sent again and the person leaves, it is reached.
 3. move_base killed (SIGKILL) during random_navigation.py's goal: roslaunch starts it again,
    random_navigation notices and sends the goal again, and its count goes on to the end.
 4. slam_gmapping killed: roslaunch starts it again, a new map starts (with a message) and a goal on
@@ -123,7 +123,12 @@ class NavigationFaultsTest(unittest.TestCase):
         spawn = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)
         delete = rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)
         goal = (-1.5, -3.3)
-        req = SpawnModelRequest(model_name='visitor', model_xml='<sdf version="1.6"><actor name="v"/></sdf>')
+        # A slim person (0.18 m): its seen surface puts the goal cell within the inflation's inscribed
+        # radius (0.2 m), so the costmap knows the goal is taken. Around a 0.25 m person the goal
+        # cell stays outside it, and move_base circles the person until the client gives up.
+        slim = ('<sdf version="1.6"><actor name="v"><link name="b"><collision name="c"><geometry><cylinder>'
+                '<radius>0.18</radius><length>1.7</length></cylinder></geometry></collision></link></actor></sdf>')
+        req = SpawnModelRequest(model_name='visitor', model_xml=slim)
         req.initial_pose.position.x, req.initial_pose.position.y, req.initial_pose.orientation.w = goal[0], goal[1], 1.0
         self.assertTrue(spawn(req).success)
         rospy.sleep(2.0)  # the laser sees the person, the costmaps mark it

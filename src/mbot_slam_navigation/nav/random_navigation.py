@@ -357,6 +357,8 @@ class RandomNavigation:
             while self.server_silence() > SERVER_SILENCE and rospy.Time.now() < answer_by:
                 try:
                     rospy.sleep(0.2)  # connected: wait for the new process's first status
+                except rospy.ROSTimeMovedBackwardsException:
+                    answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)  # a reset: wait afresh
                 except rospy.ROSInterruptException:
                     return None
             resends += 1
