@@ -148,6 +148,25 @@ class SimHomeTest(unittest.TestCase):
         self.assertIn('no <actor>', bad.status_message)
         self.assertTrue(rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)(model_name='visitor').success)
         self.assertGreater(ahead(self.fresh_scan()), 1.5)
+        # gazebo_ros's way from a shell: spawn_model -sdf -file F -model NAME -x -y
+        import subprocess
+        self.drive(0.0, 0.0, 0.5)  # the last command (into the person) still holds until cmd_vel_timeout
+        self.teleport(-3.5, -2.0, 0.0)
+        import tempfile
+        with tempfile.NamedTemporaryFile('w', suffix='.sdf') as f:
+            f.write('<sdf version="1.6"><actor name="a"/></sdf>')
+            f.flush()
+            done = subprocess.run(['rosrun', 'mbot_slam_navigation', 'spawn_model', '-sdf', '-file', f.name, '-model',
+                                   'walker', '-x', '-2.0', '-y', '-2.0'], capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
+        walker = self.get_state(model_name='walker')
+        self.assertTrue(walker.success, walker.status_message)
+        robot = self.get_state(model_name='robot')
+        self.assertAlmostEqual(ahead(self.fresh_scan()), 1.25, delta=0.05,
+                               msg='walker at (%.2f, %.2f), robot at (%.2f, %.2f)' % (
+                                   walker.pose.position.x, walker.pose.position.y, robot.pose.position.x,
+                                   robot.pose.position.y))
+        self.assertTrue(rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)(model_name='walker').success)
 
     def test_5_pause_stops_the_clock_and_unpause_resumes(self):
         from rosgraph_msgs.msg import Clock

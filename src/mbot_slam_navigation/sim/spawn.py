@@ -1,4 +1,5 @@
-"""spawn_model: sends a URDF to the simulator's spawn service, with gazebo_ros's arguments."""
+"""spawn_model: sends a model to the simulator's spawn service, with gazebo_ros's arguments: a URDF
+robot (-urdf, spawn_urdf_model) or SDF people, <actor>s (-sdf, spawn_sdf_model)."""
 import argparse
 import sys
 
@@ -11,12 +12,13 @@ from mbot_slam_navigation.srv import SpawnModel, SpawnModelRequest
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog='spawn_model', description='Spawn a URDF model in the 2D simulator.')
+    p = argparse.ArgumentParser(prog='spawn_model', description='Spawn a URDF robot or SDF people in the 2D simulator.')
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument('-param', help='parameter holding the URDF (e.g. robot_description)')
     src.add_argument('-file', help='URDF file')
-    p.add_argument('-urdf', action='store_true', help='the model is URDF (the only kind supported)')
-    p.add_argument('-sdf', action='store_true', help=argparse.SUPPRESS)
+    kind = p.add_mutually_exclusive_group()
+    kind.add_argument('-urdf', action='store_true', help='the model is URDF (a robot; the default)')
+    kind.add_argument('-sdf', action='store_true', help='the model is SDF with <actor>s (people)')
     p.add_argument('-model', required=True, help='model name')
     for axis in ('x', 'y', 'z', 'R', 'P', 'Y'):
         p.add_argument('-' + axis, type=float, default=0.0)
@@ -32,9 +34,6 @@ def main():
     argv = rospy.myargv(sys.argv)[1:]
     args = parse_args(argv)
     rospy.init_node('spawn_model', anonymous=True)
-    if args.sdf:
-        rospy.logfatal('spawn_model: -sdf models are not supported; pass a URDF with -urdf')
-        sys.exit(1)
     if args.param:
         if not rospy.has_param(args.param):
             rospy.logfatal('spawn_model: parameter %s is not set', rospy.resolve_name(args.param))
@@ -47,7 +46,7 @@ def main():
         except OSError as e:
             rospy.logfatal('spawn_model: cannot read %s: %s', args.file, e)
             sys.exit(1)
-    service = args.gazebo_namespace.rstrip('/') + '/spawn_urdf_model'
+    service = args.gazebo_namespace.rstrip('/') + ('/spawn_sdf_model' if args.sdf else '/spawn_urdf_model')
     try:
         rospy.wait_for_service(service, timeout=args.wait)
     except rospy.ROSException:
