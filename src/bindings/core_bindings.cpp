@@ -446,6 +446,10 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)
       .def_readwrite("edge_sigma_theta", &GraphSlamParams::edge_sigma_theta)
       .def_readwrite("cauchy_scale", &GraphSlamParams::cauchy_scale)
+      .def_readwrite("redundant_distance", &GraphSlamParams::redundant_distance)
+      .def_readwrite("redundant_angle", &GraphSlamParams::redundant_angle)
+      .def_readwrite("keep_scan_poses", &GraphSlamParams::keep_scan_poses)
+      .def_readwrite("loop_solve_chi2", &GraphSlamParams::loop_solve_chi2)
       .def_readwrite("background", &GraphSlamParams::background)
       .def("validate", &GraphSlamParams::validate);
   using mbot::core::GraphSlam;
@@ -465,6 +469,11 @@ PYBIND11_MODULE(_core, m) {
              d["optimizations"] = st.optimizations;
              d["last_optimization_ms"] = st.last_optimization_ms;
              d["search_radius_m"] = st.search_radius_m;
+             d["redundant_nodes"] = st.redundant_nodes;
+             d["trimmed_nodes"] = st.trimmed_nodes;
+             d["submaps"] = st.submaps;
+             d["submaps_skipped"] = st.submaps_skipped;
+             d["closures_unsolved"] = st.closures_unsolved;
              return d;
            })
       .def("scan_poses",

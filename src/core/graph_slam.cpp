@@ -53,6 +53,9 @@ void GraphSlamParams::validate() const {
   positive(edge_sigma_xy, "edge_sigma_xy");
   positive(edge_sigma_theta, "edge_sigma_theta");
   positive(cauchy_scale, "cauchy_scale");
+  if (!(loop_solve_chi2 >= 0.0)) throw std::invalid_argument("loop_solve_chi2 must be >= 0");
+  if (!(redundant_distance >= 0.0)) throw std::invalid_argument("redundant_distance must be >= 0");
+  if (!(redundant_angle >= 0.0)) throw std::invalid_argument("redundant_angle must be >= 0");
   matcher.validate();
 }
 
@@ -112,7 +115,9 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       track_pose_ = tracked;
       track_odom_ = odom;
     }
-    if (!due) scans_.push_back({time_s, static_cast<int>(nodes_.size()) - 1, relativePose(local_anchor_, tracked)});
+    if (!due && params_.keep_scan_poses) {
+      scans_.push_back({time_s, static_cast<int>(nodes_.size()) - 1, relativePose(local_anchor_, tracked)});
+    }
   }
   if (!due) return false;
   linear_distance_ = angular_distance_ = 0.0;
@@ -130,10 +135,16 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       pose = composePose(nodes_.back().pose, z);
       edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
     }
-    nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points});
-    scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});  // the node is this scan
+    const bool redundant = !first && redundantLocked(pose);
+    nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points, redundant});
+    if (redundant) {
+      redundant_.push_back(index);
+      ++stats_.redundant_nodes;
+    }
+    if (params_.keep_scan_poses) scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});  // the node is this scan
     pending_.push_back(index);
     rebuildLocalMapLocked();
+    trimLocked();
   }
   if (params_.background) {
     work_cv_.notify_one();
@@ -143,6 +154,32 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
     pending_.clear();
   }
   return true;
+}
+
+bool GraphSlam::redundantLocked(const Eigen::Vector3d& pose) const {
+  if (params_.redundant_distance <= 0.0) return false;
+  const double d2 = params_.redundant_distance * params_.redundant_distance;
+  for (const Node& n : nodes_) {
+    if (n.redundant || !n.points) continue;
+    if ((n.pose.head<2>() - pose.head<2>()).squaredNorm() <= d2 &&
+        std::abs(normalizeAngle(n.pose.z() - pose.z())) <= params_.redundant_angle) {
+      return true;
+    }
+  }
+  return false;
+}
+
+void GraphSlam::trimLocked() {
+  // The local map holds the last local_map_nodes nodes; a node's submap is built, and the node
+  // searched for closures, by the time submapped_upto_ passes it.
+  const int local_first = static_cast<int>(nodes_.size()) - params_.local_map_nodes;
+  while (!redundant_.empty() && redundant_.front() < local_first && redundant_.front() <= submapped_upto_) {
+    Node& n = nodes_[redundant_.front()];
+    n.scan.reset();
+    n.points.reset();
+    redundant_.pop_front();
+    ++stats_.trimmed_nodes;
+  }
 }
 
 void GraphSlam::rebuildLocalMapLocked() {
@@ -201,21 +238,34 @@ void GraphSlam::backgroundLoop() {
 }
 
 void GraphSlam::flush() {
-  if (!params_.background) return;
-  std::unique_lock<std::mutex> lock(mutex_);
-  idle_cv_.wait(lock, [this] { return pending_.empty() && !busy_; });
+  int unsolved;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (params_.background) idle_cv_.wait(lock, [this] { return pending_.empty() && !busy_; });
+    unsolved = unsolved_;
+  }
+  // The background thread is idle and the caller adds no scans meanwhile (flush's contract).
+  if (unsolved > 0) optimize();
 }
 
 void GraphSlam::buildSubmap(int first, int last) {
   std::vector<Eigen::Vector2d> points;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    // Mostly places that older submaps already show: closures go to those.
+    int kept = 0;
+    for (int k = first; k <= last; ++k) kept += nodes_[k].redundant ? 0 : 1;
+    if (2 * kept < last - first + 1) {
+      ++stats_.submaps_skipped;
+      return;
+    }
     const Eigen::Vector3d& anchor = nodes_[first].pose;
     for (int k = first; k <= last; ++k) appendMoved(*nodes_[k].points, relativePose(anchor, nodes_[k].pose), points);
   }
   auto grid = std::make_shared<const LikelihoodGrid>(points, params_.delta, params_.match_sigma);
   std::lock_guard<std::mutex> lock(mutex_);
   submaps_.push_back({first, last, grid});
+  ++stats_.submaps;
 }
 
 bool GraphSlam::searchClosures(int n) {
@@ -231,10 +281,14 @@ bool GraphSlam::searchClosures(int n) {
   Eigen::Vector3d pose;
   std::shared_ptr<const std::vector<Eigen::Vector2d>> points;
   double travelled, radius;
+  bool redundant;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pose = nodes_[n].pose;
     points = nodes_[n].points;
+    redundant = nodes_[n].redundant;
+    // The submap ending at n is built and n's points are held here: nodes up to n may be trimmed.
+    if ((n + 1) % params_.submap_nodes == 0) submapped_upto_ = n;
     travelled = nodes_[n].travelled_m;
     radius = std::min(params_.loop_search_max_radius,
                       params_.loop_search_radius + params_.loop_search_growth * (travelled - last_closure_travelled_));
@@ -249,7 +303,10 @@ bool GraphSlam::searchClosures(int n) {
     }
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
-  if (static_cast<int>(candidates.size()) > params_.loop_candidates) candidates.resize(params_.loop_candidates);
+  // A redundant node repeats a place the map has: one closure to the nearest submap anchors it, and
+  // more would only grow the graph.
+  const int wanted = redundant ? std::min(1, params_.loop_candidates) : params_.loop_candidates;
+  if (static_cast<int>(candidates.size()) > wanted) candidates.resize(wanted);
 
   bool added = false;
   for (const Candidate& c : candidates) {
@@ -284,7 +341,12 @@ bool GraphSlam::searchClosures(int n) {
     }
     edges_.push_back({c.anchor_index, n, refined, edgeInformation(1.0), true});
     last_closure_travelled_ = travelled;
-    added = true;
+    const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);
+    if (err.dot(edges_.back().information * err) > params_.loop_solve_chi2) {
+      added = true;
+    } else {
+      ++unsolved_;
+    }
   }
   return added;
 }
@@ -336,6 +398,7 @@ void GraphSlam::optimize() {
       ++stats_.loop_rejected_inconsistent;
     }
     ++stats_.optimizations;
+    unsolved_ = 0;
     stats_.last_optimization_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -378,6 +441,7 @@ GraphSlamStats GraphSlam::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
   GraphSlamStats out = stats_;
   out.nodes = static_cast<int>(nodes_.size());
+  out.closures_unsolved = unsolved_;
   out.loop_closures = static_cast<int>(std::count_if(edges_.begin(), edges_.end(), [](const PoseGraphEdge& e) { return e.robust; }));
   return out;
 }
@@ -399,7 +463,9 @@ OccupancyImage GraphSlam::occupancy(double occ_thresh) const {
     map_nodes_ = 0;
     map_dirty_ = false;
   }
-  for (std::size_t k = map_nodes_; k < scans.size(); ++k) registrar_.registerScan(map_, scans[k].first, *scans[k].second);
+  for (std::size_t k = map_nodes_; k < scans.size(); ++k) {
+    if (scans[k].second) registrar_.registerScan(map_, scans[k].first, *scans[k].second);  // null: trimmed
+  }
   map_nodes_ = static_cast<int>(scans.size());
   return map_.toOccupancy(occ_thresh);
 }

@@ -148,6 +148,10 @@ class SlamGmappingNode {
     param("loop_min_response", g.loop_min_response);
     param("loop_ambiguity", g.loop_ambiguity);
     param("loop_candidates", g.loop_candidates);
+    param("redundant_distance", g.redundant_distance);
+    param("redundant_angle", g.redundant_angle);
+    param("loop_solve_chi2", g.loop_solve_chi2);
+    g.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
     // The parameters both backends share have gmapping's names; read once above.
     g.linear_update = p.linear_update;
     g.angular_update = p.angular_update;

@@ -31,6 +31,28 @@ def artifact_dir() -> str:
     return d
 
 
+class RosoutFile:
+    """Every node's /rosout lines of at least `level` (rosgraph_msgs/Log: 2 INFO, 4 WARN) appended to
+    `path` as they come, with the ROS time, so that a failed run in CI leaves what move_base, amcl
+    and slam_gmapping said beside the test's result (rostest keeps output="screen" nodes' lines only
+    in its own stdout)."""
+
+    def __init__(self, path: str, level: int = 2):
+        import rospy
+        from rosgraph_msgs.msg import Log
+        self.level = level
+        self.file = open(path, 'w', buffering=1)
+        self.sub = rospy.Subscriber('/rosout', Log, self.on_log, queue_size=500)
+
+    def on_log(self, msg) -> None:
+        if msg.level >= self.level and not self.file.closed:
+            self.file.write('[%d] [%.2f] %s: %s\n' % (msg.level, msg.header.stamp.to_sec(), msg.name, msg.msg))
+
+    def close(self) -> None:
+        self.sub.unregister()
+        self.file.close()
+
+
 class RvizScreen:
     def __init__(self, config: str, log_path: str, size=(1400, 1000)):
         self.xvfb = subprocess.Popen(['Xvfb', '-displayfd', '1', '-screen', '0', '%dx%dx24' % size, '-nolisten', 'tcp'],

@@ -32,8 +32,8 @@ from mbot_slam_navigation.maps.map_io import SAVER_OCCUPIED, load_map
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
 from mbot_slam_navigation.sim.sdf_world import load_world
-from rviz_screen import (RvizScreen, artifact_dir, laser_pixels, map_free_pixels, render_area, robot_pixels,
-                         to_pixel, wait_for)
+from rviz_screen import (RosoutFile, RvizScreen, artifact_dir, laser_pixels, map_free_pixels, render_area,
+                         robot_pixels, to_pixel, wait_for)
 
 PKG = rospkg.RosPack().get_path('mbot_slam_navigation')
 CLICK_GOAL = (-3.0, -2.0)  # [m, map] a 2D Nav Goal in the living room, 3.6 m from the spawn point
@@ -47,6 +47,7 @@ class ExplorationTutorialTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.out = artifact_dir()
+        cls.rosout = RosoutFile(os.path.join(cls.out, 'exploration_rosout.log'))
         cls.lock = threading.Lock()
         cls.truth = None
         cls.contacts, cls.clicked, cls.results = [], [], []

@@ -48,10 +48,10 @@ struct Drive {
   std::vector<Eigen::Vector3d> truth, odom;
 };
 
-// Two laps of the centre line, counter-clockwise from (-5, -5): 0.1 m per scan on the straights,
+// Laps of the centre line, counter-clockwise from (-5, -5): 0.1 m per scan on the straights,
 // 0.1 rad per scan in the corners. Odometry overestimates distance by 2 % and turns by 3 %, and
 // drifts 0.01 rad per metre: after 80 m it is metres off.
-Drive twoLaps() {
+Drive laps(int count) {
   Drive d;
   Eigen::Vector3d truth(-5, -5, 0), odom = truth;
   d.truth.push_back(truth);
@@ -62,7 +62,7 @@ Drive twoLaps() {
     d.truth.push_back(truth);
     d.odom.push_back(odom);
   };
-  for (int lap = 0; lap < 2; ++lap) {
+  for (int lap = 0; lap < count; ++lap) {
     for (int side = 0; side < 4; ++side) {
       for (int k = 0; k < 100; ++k) step(0.1, 0.0);
       for (int k = 0; k < 15; ++k) step(0.0, M_PI / 2.0 / 15.0);
@@ -70,6 +70,8 @@ Drive twoLaps() {
   }
   return d;
 }
+
+Drive twoLaps() { return laps(2); }
 
 GraphSlamParams corridorParams() {
   GraphSlamParams p;
@@ -81,11 +83,19 @@ GraphSlamParams corridorParams() {
   return p;
 }
 
-double endError(GraphSlam& slam, const Drive& d, const World2D& w) {
-  std::mt19937 rng(7);
-  for (std::size_t i = 0; i < d.truth.size(); ++i) slam.processScan(d.odom[i], scanAt(w, d.truth[i], rng), 0.1 * i);
+double endError(GraphSlam& slam, const Drive& d, const World2D& w, std::size_t from = 0, std::size_t to = SIZE_MAX) {
+  std::mt19937 rng(7 + from);
+  to = std::min(to, d.truth.size());
+  for (std::size_t i = from; i < to; ++i) slam.processScan(d.odom[i], scanAt(w, d.truth[i], rng), 0.1 * i);
   slam.flush();
-  return (slam.currentPose().head<2>() - d.truth.back().head<2>()).norm();
+  return (slam.currentPose().head<2>() - d.truth[to - 1].head<2>()).norm();
+}
+
+/// The occupancy image's value at a world point [m].
+int valueAt(const OccupancyImage& img, double x, double y) {
+  const int cx = static_cast<int>(std::floor((x - img.origin.x()) / img.resolution));
+  const int cy = static_cast<int>(std::floor((y - img.origin.y()) / img.resolution));
+  return img.data[static_cast<std::size_t>(cy) * img.width + cx];
 }
 
 }  // namespace
@@ -120,11 +130,7 @@ TEST(GraphSlam, TheMapHasTheCorridorWallsWhereTheyAre) {
   ASSERT_GT(img.width, 0);
   // Occupied cells on the outer wall's inner face (x = 6.0) between features, and free space on
   // the centre line.
-  auto at = [&](double x, double y) {
-    const int cx = static_cast<int>(std::floor((x - img.origin.x()) / img.resolution));
-    const int cy = static_cast<int>(std::floor((y - img.origin.y()) / img.resolution));
-    return img.data[static_cast<std::size_t>(cy) * img.width + cx];
-  };
+  auto at = [&](double x, double y) { return valueAt(img, x, y); };
   int wall = 0;
   for (double y = -1.0; y <= 1.0; y += 0.1) wall += at(6.02, y) == 100 || at(5.97, y) == 100;
   EXPECT_GE(wall, 18);
@@ -139,6 +145,38 @@ TEST(GraphSlam, AnsweringInTheBackgroundGivesTheSameClosedLoop) {
   GraphSlam slam(p);
   EXPECT_LT(endError(slam, twoLaps(), w), 0.05);
   EXPECT_GE(slam.stats().loop_closures, 3);
+}
+
+// A robot left running goes round the same rooms for hours: after the first laps, the nodes repeat
+// places the map has, so their scans are freed and no new submaps are kept; the map and the pose
+// stay as good, and closures that agree with the graph do not make it solve again.
+TEST(GraphSlam, GoingRoundTheSameLoopKeepsScansOnlyForNewPlaces) {
+  const World2D w = squareCorridor();
+  const Drive d = laps(6);
+  const std::size_t lap = d.truth.size() / 6;
+  GraphSlam slam(corridorParams());
+  EXPECT_LT(endError(slam, d, w, 0, 2 * lap), 0.05);
+  const GraphSlamStats two = slam.stats();
+  EXPECT_LT(endError(slam, d, w, 2 * lap), 0.05) << "after six laps";
+  const GraphSlamStats six = slam.stats();
+  const int later_nodes = six.nodes - two.nodes;
+  ASSERT_GT(later_nodes, 200);
+  EXPECT_GE(six.trimmed_nodes - two.trimmed_nodes, later_nodes * 8 / 10) << "laps 3-6 repeat laps 1-2";
+  EXPECT_LE(six.submaps - two.submaps, 2);
+  EXPECT_GE(six.loop_closures - two.loop_closures, later_nodes / 2) << "repeated places still close on the map";
+  EXPECT_LE(six.optimizations - two.optimizations, (six.loop_closures - two.loop_closures) / 4);
+  const OccupancyImage img = slam.occupancy(0.25);
+  int wall = 0;
+  for (double y = -1.0; y <= 1.0; y += 0.1) wall += valueAt(img, 6.02, y) == 100 || valueAt(img, 5.97, y) == 100;
+  EXPECT_GE(wall, 18);
+  EXPECT_EQ(valueAt(img, 5.0, 0.0), 0);
+
+  GraphSlamParams keep_all = corridorParams();
+  keep_all.redundant_distance = 0.0;
+  GraphSlam reference(keep_all);
+  endError(reference, d, w, 0, 3 * lap);
+  EXPECT_EQ(reference.stats().trimmed_nodes, 0);
+  EXPECT_GT(reference.stats().submaps, two.submaps + 5);
 }
 
 TEST(GraphSlam, RejectsBadParametersByName) {

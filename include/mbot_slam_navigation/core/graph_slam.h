@@ -16,7 +16,10 @@
 // ambiguous: no other pose at least 0.3 m or 0.1 rad away scores within loop_ambiguity of it
 // (a corridor, a row of doors).
 //
-// Optimization. After new closures the graph is solved (pose_graph.h): first with a wide Cauchy
+// Optimization. After new closures the graph is solved (pose_graph.h) unless every new closure
+// agrees with the current estimate (error below loop_solve_chi2; a robot revisiting a well-mapped
+// home): a solve would move nothing, and its cost grows with the graph. Such closures join the
+// next solve (or flush()). A solve runs first with a wide Cauchy
 // loss, then with the nominal one, so that consistent closures pull fully and a wrong one is
 // down-weighted; a closure still inconsistent with the rest afterwards (Mahalanobis error above
 // loop_reject_chi2) is removed and the graph solved again. This runs in a background thread
@@ -26,6 +29,13 @@
 // Map. A gmapping counting grid (slam_grid.h) of every node's scan at its optimized pose. Nodes
 // are added as they come; the grid is rebuilt from all nodes only after an optimization moved some
 // node by more than half a cell or 0.5 degree.
+//
+// A robot left running in one home revisits the same places for hours; memory must not grow with
+// time. A new node within redundant_distance and redundant_angle of an older node that keeps its
+// scan is redundant: it joins the chain and is matched against the nearest submap (so the robot
+// stays anchored to the old map), but once the local map and its submap no longer need it, its scan and
+// match points are freed, and a submap made mostly of redundant nodes is not kept. What is kept
+// then grows with the area seen, not with the time spent (a node's pose and edges, ~1 KB, remain).
 //
 // Frames and units: as slam_backend.h.
 #pragma once
@@ -76,6 +86,17 @@ struct GraphSlamParams {
   double edge_sigma_xy = 0.03;      ///< [m] standard deviation of an edge's translation
   double edge_sigma_theta = 0.01;   ///< [rad] and of its rotation
   double cauchy_scale = 3.0;        ///< Cauchy loss scale of closures, in standard deviations
+  /// New closures all with a squared Mahalanobis error at the current estimate below this (7.8: 95%
+  /// for 3 degrees of freedom) do not trigger a solve (`~loop_solve_chi2`); 0 solves after every closure.
+  double loop_solve_chi2 = 7.8;
+  /// [m] a new node this close to an older node that keeps its scan (and within redundant_angle of
+  /// its heading) keeps its scan only while the local map and its submap need it
+  /// (`~redundant_distance`); 0 keeps every node's scan.
+  double redundant_distance = 0.3;
+  double redundant_angle = 0.5;     ///< [rad] (`~redundant_angle`)
+  /// Keep every scan's tracked pose for scanPoses() (offline scoring; 40 bytes a scan, so the node
+  /// turns it off).
+  bool keep_scan_poses = true;
   bool background = true;           ///< optimize in a background thread (false: inline, deterministic)
   /// Throws std::invalid_argument naming the ROS parameter when a value is unusable.
   void validate() const;
@@ -89,8 +110,13 @@ struct GraphSlamStats {
   int loop_rejected_ambiguous = 0;
   int loop_rejected_inconsistent = 0;  ///< removed after optimization
   int optimizations = 0;
+  int closures_unsolved = 0;        ///< closures that agreed with the estimate and await the next solve
   double last_optimization_ms = 0.0;
   double search_radius_m = 0.0;     ///< current loop search radius
+  int redundant_nodes = 0;          ///< nodes found redundant (redundant_distance)
+  int trimmed_nodes = 0;            ///< of those, nodes whose scan and points are freed
+  int submaps = 0;                  ///< submaps kept for closures
+  int submaps_skipped = 0;          ///< submaps not kept (mostly redundant nodes)
 };
 
 class GraphSlam : public SlamBackend {
@@ -106,12 +132,12 @@ class GraphSlam : public SlamBackend {
   OccupancyImage occupancy(double occ_thresh) const override;
   int updates() const override;
 
-  /// Waits until the background thread has searched every node for closures and the graph is
-  /// optimized (for offline runs and tests; the node never calls it).
+  /// Waits until the background thread has searched every node for closures, then solves the
+  /// graph if closures await a solve (for offline runs and tests; the node never calls it).
   void flush();
   GraphSlamStats stats() const;
   /// Every tracked scan's pose (time [s], base in map), each moved with the node before it by every
-  /// optimization since: a finer trajectory than the nodes alone.
+  /// optimization since: a finer trajectory than the nodes alone. Empty unless keep_scan_poses.
   std::vector<std::pair<double, Eigen::Vector3d>> scanPoses() const;
   /// The graph's edges (chain and closures), for drawing and tests.
   std::vector<PoseGraphEdge> edges() const;
@@ -123,8 +149,9 @@ class GraphSlam : public SlamBackend {
     Eigen::Vector3d odom;   // base in odom
     double time_s;
     double travelled_m;     // odometry path length from the first node
-    std::shared_ptr<const LaserScan> scan;
-    std::shared_ptr<const std::vector<Eigen::Vector2d>> points;  // match points, base frame
+    std::shared_ptr<const LaserScan> scan;  // null once trimmed
+    std::shared_ptr<const std::vector<Eigen::Vector2d>> points;  // match points, base frame; null once trimmed
+    bool redundant;          // an older node that keeps its scan saw the same place
   };
   struct TrackedScan {
     double time_s;
@@ -139,9 +166,14 @@ class GraphSlam : public SlamBackend {
   Eigen::Vector3d matchLocally(const Eigen::Vector3d& predicted, const std::vector<Eigen::Vector2d>& points);
   void rebuildLocalMapLocked();  // mutex_ held
   void backgroundLoop();
-  /// Closure search for one node and the submap that it completes; returns true if edges were added.
+  /// Closure search for one node and the submap that it completes; returns true if it added an
+  /// edge that the current estimate does not already satisfy (loop_solve_chi2).
   bool searchClosures(int node);
   void buildSubmap(int first, int last);
+  /// Whether a node at `pose` would repeat an older node that keeps its scan (mutex_ held).
+  bool redundantLocked(const Eigen::Vector3d& pose) const;
+  /// Frees the scans of redundant nodes that neither the local map nor a submap still needs (mutex_ held).
+  void trimLocked();
   void optimize();
   Eigen::Matrix3d edgeInformation(double scale) const;
 
@@ -155,6 +187,9 @@ class GraphSlam : public SlamBackend {
   std::vector<Submap> submaps_;
   std::vector<TrackedScan> scans_;
   std::deque<int> pending_;  // nodes not yet searched for closures
+  std::deque<int> redundant_;  // redundant nodes whose scans are still held, oldest first
+  int submapped_upto_ = -1;
+  int unsolved_ = 0;         // closures added since the last solve that did not ask for one    // last node whose submap has been built (or skipped) and searched
   // Submap grids whose pooled levels are kept, most recently matched first (closure thread only).
   static constexpr int kPyramidCache = 16;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
