@@ -13,6 +13,8 @@ namespace mbot {
 namespace core {
 namespace {
 
+constexpr double kSpinSpot_m = 0.05;  // moving less than this counts as turning on the spot
+
 bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
 
 /// ROS's computeNewVelocity: move towards the sampled speed by at most a * dt.
@@ -245,6 +247,7 @@ void LocalPlanner::resetOscillation() {
   stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
   rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
   escaping_ = false;
+  spun_ = 0.0;
 }
 
 void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) {
@@ -257,6 +260,28 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
   goal_grid_.markWithinRobot(robot);  // ROS marks only the path map; the goal map needs it as much
   path_grid_.setPath(map, plan_);
   goal_grid_.setLocalGoal(map, plan_, &local_goal_);
+  dense_plan_.clear();
+  dense_reach_ = 2.0 * map.resolution();
+  for (const Eigen::Vector2d& p : densifyPlan(plan_, map.resolution())) {
+    if (!map.contains(map.worldToCell(p))) {
+      if (!dense_plan_.empty()) break;
+      continue;
+    }
+    dense_plan_.push_back(p);
+  }
+}
+
+int LocalPlanner::alongPlan(const Eigen::Vector2d& point) const {
+  int best = -1;
+  double best_d2 = dense_reach_ * dense_reach_;
+  for (std::size_t i = 0; i < dense_plan_.size(); ++i) {
+    const double d2 = (dense_plan_[i] - point).squaredNorm();
+    if (d2 <= best_d2) {
+      best_d2 = d2;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
 }
 
 double LocalPlanner::headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const {
@@ -440,8 +465,16 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
 
   Trajectory best, comp;
   best.cost = -1.0;
-  bool progressing = false;  // some valid forward trajectory ends nearer the plan and goal
+  bool progressing = false;  // some valid forward trajectory ends nearer the plan and goal, or farther along the plan
   const double progress_now = progressAt(map, pose);
+  const int along_now = alongPlan(pose.head<2>());
+  if ((pose.head<2>() - spin_spot_).norm() > kSpinSpot_m) {
+    spun_ = 0.0;
+    spin_spot_ = pose.head<2>();
+  } else {
+    spun_ += std::abs(normalizeAngle(pose.z() - spin_yaw_));
+  }
+  spin_yaw_ = pose.z();
   // Costs at or above this cannot win (the comparisons below are < best and <= best), so only the
   // trajectories that may are scored exactly.
   auto bar = [&]() { return best.cost < 0 || best.yv != 0.0 ? std::numeric_limits<double>::infinity() : best.cost; };
@@ -460,7 +493,13 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     auto consider = [&](double vx, double vy, double vth) {
       generate(map, pose, vel, vx, vy, vth, impossible, comp, -std::numeric_limits<double>::infinity());
       if (comp.cost < 0) return;
-      if (comp.xv > 0 && comp.progress < progress_now - 1e-9) progressing = true;
+      // Farther along the plan and still on it (two cells) is progress too, whatever the
+      // 4-connected distances say: they step by a cell either way along a diagonal.
+      if (comp.xv > 0 && !progressing &&
+          (comp.progress < progress_now - 1e-9 ||
+           (along_now >= 0 && !comp.points.empty() && alongPlan(comp.points.back().head<2>()) > along_now))) {
+        progressing = true;
+      }
       samples.push_back({vx, vy, vth, comp.cost, comp.cost_exact});
     };
     double vx_samp = min_vx;
@@ -475,6 +514,10 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     }
     if (p.holonomic_robot) {
       for (double vy : {0.1, -0.1}) consider(0.1, vy, 0.0);
+    }
+    if (!progressing && spun_ > 2.0 * M_PI) {
+      // A full circle on the spot showed no progress; another would show nothing new.
+      for (const Sample& s : samples) progressing = progressing || s.vx > 0;
     }
     std::vector<std::size_t> order(samples.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;

@@ -5,6 +5,7 @@
 
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/local_planner.h"
+#include "mbot_slam_navigation/core/pose2d.h"
 
 using namespace mbot::core;
 
@@ -155,6 +156,54 @@ TEST(LocalPlanner, ApproachesAGoalNearAWallInsteadOfSpinning) {
   }
   ASSERT_LE(spin, t.cost) << "not the situation where ROS's rule spins";
   EXPECT_GT(t.xv, 0.0) << "spinning on the spot although a forward move gets nearer the goal";
+}
+
+TEST(LocalPlanner, FollowsAPlanThatRunsDiagonallyAwayFromTheGoalInsteadOfSpinning) {
+  // Out of a doorway at 45 degrees: the plan runs south-east, then east, then north-east to the
+  // local goal. Along the first leg the 4-connected goal distance stays the same (one cell nearer
+  // in x, one farther in y) and the path distance is 0, so no move lowers their sum: the robot
+  // spun on the spot for minutes in the simulated home (exploration rostest) until move_base's
+  // back_up recovery happened to move it.
+  const Costmap m(100, 100, 0.05, {0, 0});
+  std::vector<Eigen::Vector2d> plan = straightPlan({1.0, 3.0}, {1.5, 2.5});
+  for (const auto& leg : {straightPlan({1.5, 2.5}, {3.0, 2.5}), straightPlan({3.0, 2.5}, {4.0, 3.5})}) {
+    plan.insert(plan.end(), leg.begin() + 1, leg.end());
+  }
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(plan);
+  Eigen::Vector3d pose(1.0, 3.0, -M_PI / 4), vel(0, 0, 0);
+  const Trajectory first = lp.findBestPath(m, pose, vel);
+  ASSERT_GE(first.cost, 0.0);
+  EXPECT_GT(first.xv, 0.0) << "turned on the spot (vtheta " << first.thetav << ") instead of following the plan";
+  // Closed loop at 3 Hz: it gets round the corner of the plan.
+  for (int k = 0; k < 30; ++k) {
+    const Trajectory t = lp.findBestPath(m, pose, vel);
+    ASSERT_GE(t.cost, 0.0);
+    pose = integrateArc(pose, t.xv / 3.0, t.thetav / 3.0);
+    vel = {t.xv, 0, t.thetav};
+  }
+  EXPECT_GT(pose.x(), 1.8) << "stuck at (" << pose.x() << ", " << pose.y() << ")";
+}
+
+TEST(LocalPlanner, AFullTurnOnTheSpotWithoutProgressEndsInItsBestForwardMove) {
+  // On the plan's last cell no move gets nearer the plan or the goal: it turns on the spot, and
+  // after one full circle takes a forward move instead of turning for ever.
+  const Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({1.025, 2.525}, {2.525, 2.525}));  // cell centres
+  Eigen::Vector3d pose(2.525, 2.525, 0.3), vel(0, 0, 0);
+  double turned = 0.0;
+  int forward_at = -1;
+  for (int k = 0; k < 60 && forward_at < 0; ++k) {
+    const Trajectory t = lp.findBestPath(m, pose, vel);
+    ASSERT_GE(t.cost, 0.0);
+    if (t.xv > 0) forward_at = k;
+    turned += std::abs(t.thetav) / 3.0;
+    pose = integrateArc(pose, t.xv / 3.0, t.thetav / 3.0);
+    vel = {t.xv, 0, t.thetav};
+  }
+  ASSERT_GE(forward_at, 0) << "still turning after " << turned << " rad";
+  EXPECT_GE(turned, 2.0 * M_PI - 0.6) << "moved before a full turn showed no progress";
 }
 
 TEST(LocalPlanner, AFootprintAlreadyTouchingAWallMovesOutAndNeverDeeper) {

@@ -17,7 +17,12 @@
 // lower than the best forward trajectory. Near a wall the occupancy term of every forward move
 // grows faster than its distance terms shrink (with meter_scoring and the tutorials' biases), so
 // ROS's robot spins in place there until move_base gives up; here a forward move that makes
-// progress is always preferred to spinning on the spot.
+// progress is always preferred to spinning on the spot. And progress includes moving farther along
+// the plan while staying on it (within two cells): the distances are ROS's 4-connected ones, so
+// where the plan runs diagonally away from the goal's row or column (leaving a doorway at 45
+// degrees, say) no move lowers their sum, and ROS's robot, like ours before, turns on the spot
+// until move_base gives up. Whatever the cause, a robot that has turned a full circle on the spot
+// without finding progress takes its best forward move (a turn more would show it nothing new).
 //
 // Frames: every pose is in the local costmap's global frame (x [m], y [m], yaw [rad]); velocities
 // are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
@@ -126,6 +131,9 @@ class LocalPlanner {
                       const Eigen::Vector3d& command) const;
   /// The distance terms at the robot's own cell (what a trajectory must beat to make progress).
   double progressAt(const Costmap& map, const Eigen::Vector3d& pose) const;
+  /// Index along the plan (densified to the costmap's cells, as far as it stays on the local map)
+  /// of the plan point nearest `point` [m], if one lies within two cells; -1 otherwise.
+  int alongPlan(const Eigen::Vector2d& point) const;
   /// Recomputes the path and goal distance grids for `pose` without choosing a command.
   void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
   /// Clears the oscillation and escape state (a new goal).
@@ -162,6 +170,8 @@ class LocalPlanner {
   Footprint footprint_;
   double path_bias_, goal_bias_;  // scaled by the resolution with meter_scoring (set per cycle)
   std::vector<Eigen::Vector2d> plan_;
+  std::vector<Eigen::Vector2d> dense_plan_;  // plan_ at cell spacing, while on the local map (updateGrids)
+  double dense_reach_ = 0.0;                 // [m] two cells
   bool goal_valid_ = false;
   Eigen::Vector2d final_goal_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d local_goal_ = Eigen::Vector2d::Zero();
@@ -179,6 +189,9 @@ class LocalPlanner {
   bool escaping_ = false;
   Eigen::Vector2d prev_ = Eigen::Vector2d::Zero(), escape_ = Eigen::Vector2d::Zero();
   double escape_theta_ = 0.0;
+  // Turning on the spot: where it started and how far it has turned since [rad].
+  Eigen::Vector2d spin_spot_ = Eigen::Vector2d::Zero();
+  double spin_yaw_ = 0.0, spun_ = 0.0;
 };
 
 }  // namespace core
