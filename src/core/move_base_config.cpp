@@ -45,6 +45,7 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
   c.max_planning_retries = r.integer("max_planning_retries", -1);
   c.oscillation_timeout = r.number("oscillation_timeout", 20.0, 0.0);
   c.oscillation_distance = r.number("oscillation_distance", 0.5, 0.0);
+  c.progress_timeout = r.number("progress_timeout", 60.0, 0.0);
   c.recovery_behavior_enabled = r.boolean("recovery_behavior_enabled", true);
   c.clearing_rotation_allowed = r.boolean("clearing_rotation_allowed", true);
   c.shutdown_costmaps = r.boolean("shutdown_costmaps", false);

@@ -11,13 +11,15 @@
 // Differences from ROS, on purpose: a failed replan while moving stops the robot (ROS keeps
 // following the old plan, possibly through a new obstacle); oscillation detection is on by default;
 // `~make_plan` answers while a goal is active; a back-up recovery is among the defaults; every
-// abort says why.
+// abort says why; `~progress_timeout` (60 s) bounds a goal that driving about never brings nearer
+// (a robot circling a person who stands on its goal), which ROS would pursue for ever.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -53,7 +55,21 @@ using Vec3 = Eigen::Vector3d;
 using Path2 = std::vector<Eigen::Vector2d>;
 using ros_glue::SimRate;
 enum class State { kPlanning, kControlling, kClearing };
-enum class Trigger { kNone, kPlanning, kControlling, kOscillation };
+enum class Trigger { kNone, kPlanning, kControlling, kOscillation, kNoProgress };
+
+constexpr double kGoalProgress_m = 0.25;  // the path to the goal this much shorter is progress (progress_timeout)
+
+/// [m] Along `plan` from its point nearest `pose` to its end, plus the way to that point.
+double remainingPath(const Path2& plan, const Eigen::Vector2d& pose) {
+  if (plan.empty()) return std::numeric_limits<double>::infinity();
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < plan.size(); ++i) {
+    if ((plan[i] - pose).squaredNorm() < (plan[nearest] - pose).squaredNorm()) nearest = i;
+  }
+  double length = (plan[nearest] - pose).norm();
+  for (std::size_t i = nearest + 1; i < plan.size(); ++i) length += (plan[i] - plan[i - 1]).norm();
+  return length;
+}
 
 std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
 std::string fmt(const char* f, ...) {
@@ -341,6 +357,8 @@ class MoveBase {
     planning_retries_ = 0;
     recovery_index_ = 0;
     trigger_ = Trigger::kNone;
+    goal_best_m_ = std::numeric_limits<double>::infinity();
+    goal_progress_time_ = now;
     why_.clear();
     controller_->reset();
   }
@@ -430,6 +448,15 @@ class MoveBase {
       }
     }
 
+    if (!plan_.empty()) {
+      const double remaining = remainingPath(plan_, pose->head<2>());
+      if (remaining < goal_best_m_ - kGoalProgress_m) {
+        goal_best_m_ = remaining;
+        goal_progress_time_ = now;
+        if (trigger_ == Trigger::kNoProgress) recovery_index_ = 0;
+      }
+    }
+
     if (state_ == State::kControlling) {
       if (new_plan_) {
         controller_->setPlan(toLocal(plan_), goal.z());
@@ -455,7 +482,14 @@ class MoveBase {
         return true;
       }
       publishLocal();
-      if (config_.oscillation_timeout > 0 && (now - last_oscillation_reset_).toSec() > config_.oscillation_timeout) {
+      if (config_.progress_timeout > 0 && (now - goal_progress_time_).toSec() > config_.progress_timeout) {
+        stop();
+        why_ = fmt("the path to the goal has not got %.2f m shorter than %.2f m in progress_timeout %.1f s (something the "
+                   "laser sees from one side only, a person, may stand on the goal)",
+                   kGoalProgress_m, goal_best_m_, config_.progress_timeout);
+        state_ = State::kClearing;
+        trigger_ = Trigger::kNoProgress;
+      } else if (config_.oscillation_timeout > 0 && (now - last_oscillation_reset_).toSec() > config_.oscillation_timeout) {
         stop();
         why_ = fmt("moved less than oscillation_distance %.2f m in oscillation_timeout %.1f s", config_.oscillation_distance,
                    config_.oscillation_timeout);
@@ -496,13 +530,14 @@ class MoveBase {
       }
       const char* trigger_text = trigger_ == Trigger::kPlanning      ? "no valid plan"
                                  : trigger_ == Trigger::kControlling ? "no valid control"
+                                 : trigger_ == Trigger::kNoProgress  ? "no progress towards the goal"
                                                                      : "oscillating";
       if (config_.recovery_behavior_enabled && recovery_index_ < recoveries.size()) {
         const auto& r = recoveries[recovery_index_];
         ROS_WARN("move_base: %s (%s); running recovery behaviour %s", trigger_text, why_.c_str(), r.name.c_str());
         runRecovery(r);
         ++recovery_index_;
-        last_oscillation_reset_ = last_valid_plan_ = last_valid_control_ = ros::Time::now();
+        last_oscillation_reset_ = last_valid_plan_ = last_valid_control_ = goal_progress_time_ = ros::Time::now();
         planning_retries_ = 0;
         state_ = State::kPlanning;
         return false;
@@ -510,6 +545,8 @@ class MoveBase {
       const char* text = trigger_ == Trigger::kPlanning ? "Failed to find a valid plan. Even after executing recovery behaviors."
                          : trigger_ == Trigger::kControlling
                              ? "Failed to find a valid control. Even after executing recovery behaviors."
+                         : trigger_ == Trigger::kNoProgress
+                             ? "Robot is making no progress towards the goal. Even after executing recovery behaviors."
                              : "Robot is oscillating. Even after executing recovery behaviors.";
       return abort(std::string(text) + " Last reason: " + why_);
     }
@@ -680,6 +717,8 @@ class MoveBase {
   Path2 plan_;
   bool new_plan_ = false;
   ros::Time last_plan_time_, last_valid_plan_, last_valid_control_, last_oscillation_reset_;
+  ros::Time goal_progress_time_;  // when the path to the goal last got kGoalProgress_m shorter
+  double goal_best_m_ = std::numeric_limits<double>::infinity();  // [m] its shortest so far
   std::optional<Vec3> oscillation_pose_;
   int planning_retries_ = 0;
   std::size_t recovery_index_ = 0;

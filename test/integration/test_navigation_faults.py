@@ -9,6 +9,8 @@ left the robot.
    date" naming /scan; when scans return it goes on and reaches the goal.
 2. A (slim) person standing on the goal: the goal is aborted after planner_patience with the
    reason; sent again and the person leaves, it is reached.
+2b. A person of the usual 0.25 m on the goal (the goal cell looks free, the robot drives round the
+   person): move_base's progress_timeout aborts the goal with the reason.
 3. move_base killed (SIGKILL) during random_navigation.py's goal: roslaunch starts it again,
    random_navigation notices and sends the goal again, and its count goes on to the end.
 4. slam_gmapping killed: roslaunch starts it again, a new map starts (with a message) and a goal on
@@ -125,7 +127,7 @@ class NavigationFaultsTest(unittest.TestCase):
         goal = (-1.5, -3.3)
         # A slim person (0.18 m): its seen surface puts the goal cell within the inflation's inscribed
         # radius (0.2 m), so the costmap knows the goal is taken. Around a 0.25 m person the goal
-        # cell stays outside it, and move_base circles the person until the client gives up.
+        # cell stays outside it (test_2b).
         slim = ('<sdf version="1.6"><actor name="v"><link name="b"><collision name="c"><geometry><cylinder>'
                 '<radius>0.18</radius><length>1.7</length></cylinder></geometry></collision></link></actor></sdf>')
         req = SpawnModelRequest(model_name='visitor', model_xml=slim)
@@ -142,6 +144,32 @@ class NavigationFaultsTest(unittest.TestCase):
         self.assertTrue(delete(model_name='visitor').success)
         state, text = self.result(240.0)
         self.assertEqual(state, GoalStatus.SUCCEEDED, text)
+
+    def test_2b_a_broad_person_on_the_goal_ends_it_by_progress_timeout(self):
+        # A person of the default 0.25 m: the laser sees only the near side, the goal cell looks free,
+        # and driving round the person resets oscillation_timeout. progress_timeout (60 s, the
+        # launch file's default) runs the recoveries and then aborts, with the reason.
+        spawn = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)
+        delete = rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)
+        goal = (-1.5, -3.3)
+        self.send(-3.0, -2.0)  # away from the goal, where test_2 left it
+        state, text = self.result(240.0)
+        self.assertEqual(state, GoalStatus.SUCCEEDED, text)
+        req = SpawnModelRequest(model_name='broad_visitor', model_xml='<sdf version="1.6"><actor name="w"/></sdf>')
+        req.initial_pose.position.x, req.initial_pose.position.y, req.initial_pose.orientation.w = goal[0], goal[1], 1.0
+        self.assertTrue(spawn(req).success)
+        try:
+            rospy.sleep(2.0)
+            self.send(*goal)
+            state, text = self.result(900.0)
+            rospy.loginfo('with a broad person on the goal: %s', text)
+            self.assertEqual(state, GoalStatus.ABORTED, text)
+            self.assertTrue('no progress towards the goal' in text or 'is in an obstacle' in text, text)
+            with self.lock:
+                truth = self.truth
+            self.assertGreater(math.hypot(truth[1] - goal[0], truth[2] - goal[1]), 0.3, 'the robot is on the person')
+        finally:
+            self.assertTrue(delete(model_name='broad_visitor').success)
 
     def test_3_move_base_killed_mid_goal_is_respawned_and_random_navigation_goes_on(self):
         env = dict(os.environ)

@@ -35,6 +35,11 @@ struct MoveBaseConfig {
   long max_planning_retries = -1;
   double oscillation_timeout = 20.0;  ///< [s] ROS's default is 0 (off): a robot rocking forever is what users meet
   double oscillation_distance = 0.5;  ///< [m]
+  /// [s] ours, not ROS's: when the path to the goal has not got kGoalProgress_m shorter for this
+  /// long, the recoveries run as for oscillation, and after the last the goal is aborted; unlike
+  /// oscillation_timeout, driving about does not reset it (a robot circling a person who stands on
+  /// its goal). 0 disables.
+  double progress_timeout = 60.0;
   bool recovery_behavior_enabled = true, clearing_rotation_allowed = true, shutdown_costmaps = false;
   double conservative_reset_dist = 3.0;
   bool make_plan_clear_costmap = true, make_plan_add_unreachable_goal = true;
