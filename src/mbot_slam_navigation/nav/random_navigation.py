@@ -20,7 +20,9 @@ of ROS time), goal_timeout (300 s), seed (-1 = random), frame_id ('map'), base_f
 ('base_footprint'), server_timeout (60 s). With a limit it prints a summary and exits 0.
 
 Beyond the tutorial: move_base killed mid-goal (and respawned) is noticed, waited for and the goal
-sent again (pursue()), so a soak's count goes on instead of waiting out goal_timeout.
+sent again (pursue()), so a soak's count goes on instead of waiting out goal_timeout; a goal that
+move_base aborts as occupied (a person passing over the point) is sent again after OCCUPIED_WAIT s,
+at most OCCUPIED_RETRIES times, with a warning.
 """
 import math
 import os
@@ -43,6 +45,8 @@ from mbot_slam_navigation.transforms import check_planar_quaternion, yaw_to_quat
 
 SERVER_SILENCE = 5.0  # [s] of ROS time without move_base's action status (5 Hz) before it counts as gone
 MAX_RESENDS = 2       # times a goal is sent again after move_base lost it
+OCCUPIED_WAIT = 10.0  # [s] of ROS time before a goal move_base found occupied is sent again
+OCCUPIED_RETRIES = 2
 
 # actionlib_msgs/GoalStatus's states, in the order of their numbers (the tutorial's goal_states).
 GOAL_STATES = ['PENDING', 'ACTIVE', 'PREEMPTED', 'SUCCEEDED', 'ABORTED', 'REJECTED', 'PREEMPTING', 'RECALLING',
@@ -327,11 +331,26 @@ class RandomNavigation:
         MAX_RESENDS times, so the count goes on; if it does not come back within server_timeout the
         goal counts as LOST."""
         deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
-        resends = 0
+        resends = occupied = 0
         self.move_base.send_goal(self.goal(loc))
         while not rospy.is_shutdown():
             if self.move_base.wait_for_result(rospy.Duration(1.0)):
                 code = self.move_base.get_state()
+                text = self.move_base.get_goal_status_text()
+                if (code == GoalStatus.ABORTED and 'goal occupied' in text and occupied < OCCUPIED_RETRIES
+                        and rospy.Time.now() + rospy.Duration(OCCUPIED_WAIT) < deadline):
+                    occupied += 1
+                    rospy.logwarn('random_navigation: move_base aborted the goal to %s as occupied (%s); waiting %g s '
+                                  'for it to clear (a person passing?), then sending it again', loc.name, text,
+                                  OCCUPIED_WAIT)
+                    try:
+                        rospy.sleep(OCCUPIED_WAIT)
+                    except rospy.ROSTimeMovedBackwardsException:
+                        pass
+                    except rospy.ROSInterruptException:
+                        return None
+                    self.move_base.send_goal(self.goal(loc))
+                    continue
                 if code != GoalStatus.LOST or resends >= MAX_RESENDS:
                     return GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
                 why = 'lost the goal (it was restarted?)'
