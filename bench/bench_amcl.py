@@ -220,16 +220,18 @@ def kidnap():
     m = load_map(os.path.join(PKG, 'maps', 'map.yaml'))
     settings = amcl_diff()[1]
     carry_at, carry = 20.0, (3.0, 0.0)   # [s simulated], [m]: from the middle room into the right one
-    for label, overrides, relocalize in (('recovery_alpha 0.001/0.1', dict(recovery_alpha_slow=0.001,
-                                                                             recovery_alpha_fast=0.1), False),
-                                         ('amcl_diff.launch + global_localization when lost', {}, True)):
+    for label, overrides, relocalize, search in (
+            ('recovery_alpha 0.001/0.1', dict(recovery_alpha_slow=0.001, recovery_alpha_fast=0.1), False, 0.0),
+            ('amcl_diff.launch + global_localization when lost', {}, True, 0.0),
+            ('amcl_diff.launch, recovery_search_radius 3 m (the default)', {}, False, 3.0)):
         detected, recovered = [], []
         for seed in range(3):
             drive = Drive(os.path.join(PKG, 'worlds', 'wall.world'), os.path.join(PKG, 'urdf', 'myrobot.xacro'),
                           (0.0, 0.0, 0.0), WALL_ROUTE * 2, seed=seed)
             pf = make_pf(m.data, m.resolution, m.origin, seed=seed, **overrides)
             pf.init_gaussian(np.zeros(3), np.diag([0.01, 0.01, 0.01]))
-            loc = Localizer(pf, settings['update_min_d'], settings['update_min_a'], settings['resample_interval'])
+            loc = Localizer(pf, settings['update_min_d'], settings['update_min_a'], settings['resample_interval'],
+                            search_radius=search)
             a0, inc, rmin, rmax, lxy = laser_args(drive)
             carried = lost_at = back_at = None
             for odom, ranges in drive.scans(max_time=carry_at + 180.0):

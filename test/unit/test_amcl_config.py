@@ -123,6 +123,48 @@ def test_the_filter_reports_a_scan_fit_that_falls_when_the_robot_is_elsewhere():
     assert pf.last_scan_fit < 0.5
 
 
+def test_localizer_searches_near_the_last_estimate_when_lost_and_finds_the_carried_robot():
+    # A 6 m room with a cupboard in one corner (so that no turn of the room looks the same); the
+    # robot tracked at (3, 3) is carried to (1.6, 2.2), 1.6 m away, while odometry sees nothing.
+    world = _core._World2D()
+    data = np.zeros((60, 60), np.int8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100
+    data[45:55, 5:20] = 100                                   # the cupboard: x 0.5-2.0, y 4.5-5.5
+    for (cx, cy, sx, sy) in ((3.0, 0.05, 6.0, 0.1), (3.0, 5.95, 6.0, 0.1), (0.05, 3.0, 0.1, 6.0), (5.95, 3.0, 0.1, 6.0),
+                             (1.25, 5.0, 1.5, 1.0)):
+        world.add_box(np.array([cx, cy]), 0.0, sx, sy)
+    angles = -math.pi + np.arange(90) * 2 * math.pi / 90
+
+    def scan(x, y):
+        return np.array([min(world.cast_ray(np.array([x, y]), a, 8.0), 8.0) for a in angles], np.float32)
+
+    p = _core._AmclParams()
+    p.min_particles, p.max_particles = 500, 3000
+    pf = _core._Amcl(p, 1)
+    pf.set_map(_core._AmclMap(data, 0.1, (0.0, 0.0)))
+    pf.init_gaussian(np.array([3.0, 3.0, 0.0]), np.diag([0.01, 0.01, 0.01]))
+    loc = Localizer(pf, update_min_d=0.2, update_min_a=0.5, resample_interval=1, search_radius=3.0)
+    args = (-math.pi, 2 * math.pi / 90, 0.1, 8.0)
+    for _ in range(20):
+        loc.force_update = True
+        loc.update((0.0, 0.0, 0.0), *args, scan(3.0, 3.0), (0.0, 0.0))
+    assert not loc.fit.lost and loc.search is None
+    # Carried, it drives on along x and back, 0.25 m an update; odometry counts from where it was.
+    changes, searches = [], []
+    xs = (list(np.arange(1.6, 4.2, 0.25)) + list(np.arange(4.1, 1.5, -0.25))) * 2
+    for x in xs:
+        loc.update((x - 1.6, 0.0, 0.0), *args, scan(x, 2.2), (0.0, 0.0))
+        changes.append(loc.fit_change)
+        searches.append(loc.search_change)
+    assert 'lost' in changes and searches[changes.index('lost')] == 'near', (changes, searches)
+    assert 'found' in changes, changes
+    assert changes.index('found') - changes.index('lost') <= 10, changes
+    est = loc.estimate()[0]
+    assert math.hypot(est[0] - xs[-1], est[1] - 2.2) < 0.3, est
+    assert abs(est[2]) < 0.2
+    assert 'global' not in searches  # found near, no need to look farther
+
+
 def test_launch_file_names_are_unique_so_roslaunch_by_name_works():
     # `roslaunch mbot_slam_navigation move_base.launch` (the tutorial's command) fails when two files
     # in the package share the name.

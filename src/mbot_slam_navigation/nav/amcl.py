@@ -100,6 +100,9 @@ def read_parameters(r: ParamReader):
                         r.number('initial_cov_yy', 0.5 * 0.5, minimum=0.0),
                         r.number('initial_cov_aa', (math.pi / 12) ** 2, minimum=0.0)),
         'seed': r.integer('seed', 0, minimum=0),
+        # Ours (Localizer): where to look when the scans stop fitting; 0 leaves it to recovery_alpha_*.
+        'recovery_search_radius': r.number('recovery_search_radius', 3.0, minimum=0.0),
+        'recovery_search_updates': r.integer('recovery_search_updates', 20, minimum=1),
     }
     for key in IGNORED:
         if r.has(key):
@@ -119,7 +122,8 @@ class AmclNode:
         r.report_unknown()
         self.lock = threading.RLock()
         self.pf = _core._Amcl(self.params, self.s['seed'])
-        self.loc = Localizer(self.pf, self.s['update_min_d'], self.s['update_min_a'], self.s['resample_interval'])
+        self.loc = Localizer(self.pf, self.s['update_min_d'], self.s['update_min_a'], self.s['resample_interval'],
+                             self.s['recovery_search_radius'], self.s['recovery_search_updates'])
         self.map_received = False
         self.laser_cache = {}   # frame_id -> (x [m], y [m], 3x3 rotation) of the laser in the base frame
         self.map_to_odom: Optional[Tuple[float, float, float]] = None
@@ -328,16 +332,24 @@ class AmclNode:
     def report_fit(self):
         """One line when the scans stop fitting the map around the estimate, and one when they fit again."""
         change = self.loc.fit_change
-        if change is None:
+        if change is None and self.loc.search_change != 'global':
             return
         x, y, _ = self.last_estimate
         if change == 'lost':
             recovering = self.params.recovery_alpha_slow > 0 and self.params.recovery_alpha_fast > 0
+            if self.loc.search_radius > 0:
+                what = ('searching within %.1f m of it (recovery_search_radius), then, after %d updates, the whole map'
+                        % (self.loc.search_radius, self.loc.search_updates))
+            elif recovering:
+                what = 'recovery_alpha_slow/fast are set, so random particles are being injected'
+            else:
+                what = ('recovery_alpha_slow/fast and recovery_search_radius are 0, so amcl will not find it by '
+                        'itself: call the global_localization service or give a 2D Pose Estimate')
             rospy.logwarn('amcl: the scans fit the map at %.0f%% of before around the estimate (%.2f, %.2f): '
-                          'the robot may have been carried elsewhere; %s', 100.0 * self.loc.fit.ratio(), x, y,
-                          'recovery_alpha_slow/fast are set, so random particles are being injected'
-                          if recovering else 'recovery_alpha_slow/fast are 0, so amcl will not find it by itself: '
-                          'call the global_localization service or give a 2D Pose Estimate')
+                          'the robot may have been carried elsewhere; %s', 100.0 * self.loc.fit.ratio(), x, y, what)
+        elif self.loc.search_change == 'global':
+            rospy.logwarn('amcl: not found within %.1f m after %d updates; spreading the particles over the whole '
+                          'map, as global_localization does', self.loc.search_radius, self.loc.search_updates)
         else:
             rospy.loginfo('amcl: the scans fit the map again around (%.2f, %.2f)', x, y)
 

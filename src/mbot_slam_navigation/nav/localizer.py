@@ -63,15 +63,27 @@ class FitMonitor:
 
 
 class Localizer:
-    def __init__(self, pf, update_min_d: float, update_min_a: float, resample_interval: int):
+    """search_radius > 0 (ours; ROS amcl only injects random particles, by recovery_alpha_*): when the
+    FitMonitor says the robot is lost, the particles are spread around the last estimate (a normal
+    of standard deviation search_radius / 2 in x and y, any heading), where a robot carried or
+    pushed usually is; if the scans do not fit again within search_updates filter updates, over the
+    whole map's free space, as global_localization does. A search near the last estimate first also
+    keeps a symmetric building from sending the estimate to the mirror image of the true pose."""
+    def __init__(self, pf, update_min_d: float, update_min_a: float, resample_interval: int,
+                 search_radius: float = 0.0, search_updates: int = 20):
         self.pf = pf                     # _core._Amcl with a map
         self.update_min_d, self.update_min_a = update_min_d, update_min_a
         self.resample_interval = resample_interval
+        self.search_radius, self.search_updates = search_radius, search_updates
         self.odom_at_update: Optional[Pose] = None
         self.force_update = False
         self.updates = 0
         self.fit = FitMonitor()
         self.fit_change: Optional[str] = None  # 'lost' or 'found' at the last update, else None
+        self.search: Optional[str] = None      # while lost with a search: 'near', then 'global'
+        self.search_change: Optional[str] = None  # 'near' or 'global' when a search step began at the last update
+        self.search_from: Optional[Pose] = None   # the estimate the near search was centred on
+        self.search_started = 0
 
     def reinitialized(self) -> None:
         """The particles were replaced (initial pose, global localization, new map)."""
@@ -100,7 +112,28 @@ class Localizer:
         self.updates += 1
         if self.updates % self.resample_interval == 0:
             self.pf.resample()
+        self.search_change = None
+        if self.search_radius > 0:
+            self.follow_search()
         return True
+
+    def follow_search(self) -> None:
+        """Spreads the particles when the robot is lost (search_radius), widens the search when it stays lost."""
+        if self.fit_change == 'found' or not self.fit.lost:
+            self.search = None
+            return
+        if self.fit_change == 'lost':
+            self.search_from = self.estimate()[0]
+            sigma = 0.5 * self.search_radius
+            self.pf.init_gaussian(np.asarray(self.search_from, float), np.diag([sigma ** 2, sigma ** 2, np.pi ** 2]))
+            self.search = self.search_change = 'near'
+        elif self.search == 'near' and self.updates - self.search_started >= self.search_updates:
+            self.pf.init_uniform()
+            self.search = self.search_change = 'global'
+        else:
+            return
+        self.search_started = self.updates
+        self.force_update = True  # weigh the new particles at the next scan, moving or not
 
     def estimate(self):
         """(pose, covariance 3x3, share of the weight in the best cluster, clusters)."""
