@@ -5,7 +5,8 @@ use_map_topic, otherwise the map comes once from the `static_map` service); publ
 (latched), `particlecloud` (latched) and map -> odom on tf (future-dated by transform_tolerance,
 unless tf_broadcast is false); serves `global_localization`, `request_nomotion_update` and
 `set_map`. Parameters: ROS amcl's names and defaults (read_parameters()), plus ~seed (0) for the
-random generator.
+random generator and ~recovery_search_radius (3 m) / ~recovery_search_updates (20): where and how
+long to search when the scans stop fitting the map (Localizer).
 
 Differences from ROS, on purpose: "diff" and "omni" are the corrected odometry models (ROS's
 "-corrected" ones: sqrt(alpha * motion^2) is the standard deviation); yaw bins wrap when clusters are
