@@ -344,8 +344,8 @@ bool GraphSlam::searchClosures(int n) {
     const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);
     if (err.dot(edges_.back().information * err) > params_.loop_solve_chi2) {
       added = true;
-    } else {
-      ++unsolved_;
+    } else if (++unsolved_ >= kMaxUnsolved) {
+      added = true;  // small errors add up: solve now and then all the same
     }
   }
   return added;

@@ -19,7 +19,7 @@
 // Optimization. After new closures the graph is solved (pose_graph.h) unless every new closure
 // agrees with the current estimate (error below loop_solve_chi2; a robot revisiting a well-mapped
 // home): a solve would move nothing, and its cost grows with the graph. Such closures join the
-// next solve (or flush()). A solve runs first with a wide Cauchy
+// next solve, which comes at the latest after kMaxUnsolved of them (or at flush()). A solve runs first with a wide Cauchy
 // loss, then with the nominal one, so that consistent closures pull fully and a wrong one is
 // down-weighted; a closure still inconsistent with the rest afterwards (Mahalanobis error above
 // loop_reject_chi2) is removed and the graph solved again. This runs in a background thread
@@ -189,7 +189,8 @@ class GraphSlam : public SlamBackend {
   std::deque<int> pending_;  // nodes not yet searched for closures
   std::deque<int> redundant_;  // redundant nodes whose scans are still held, oldest first
   int submapped_upto_ = -1;
-  int unsolved_ = 0;         // closures added since the last solve that did not ask for one    // last node whose submap has been built (or skipped) and searched
+  int unsolved_ = 0;         // closures added since the last solve that did not ask for one
+  static constexpr int kMaxUnsolved = 10;  // after this many, they are solved anyway    // last node whose submap has been built (or skipped) and searched
   // Submap grids whose pooled levels are kept, most recently matched first (closure thread only).
   static constexpr int kPyramidCache = 16;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
