@@ -19,8 +19,8 @@
 // Optimization. After new closures the graph is solved (pose_graph.h) unless every new closure
 // agrees with the current estimate (error below loop_solve_chi2; a robot revisiting a well-mapped
 // home): a solve would move nothing, and its cost grows with the graph. Such closures join the
-// next solve, which comes at the latest after kMaxUnsolved of them (or at flush()). A solve runs first with a wide Cauchy
-// loss, then with the nominal one, so that consistent closures pull fully and a wrong one is
+// next solve, which comes at the latest after kMaxUnsolved of them (or at flush()). A solve runs
+// first with a wide Cauchy loss, then with the nominal one, so that consistent closures pull fully and a wrong one is
 // down-weighted; a closure still inconsistent with the rest afterwards (Mahalanobis error above
 // loop_reject_chi2) is removed and the graph solved again. This runs in a background thread
 // (`background`), so processScan never waits for it; nodes added meanwhile move with the last
@@ -33,9 +33,10 @@
 // A robot left running in one home revisits the same places for hours; memory must not grow with
 // time. A new node within redundant_distance and redundant_angle of an older node that keeps its
 // scan is redundant: it joins the chain and is matched against the nearest submap (so the robot
-// stays anchored to the old map), but once the local map and its submap no longer need it, its scan and
-// match points are freed, and a submap made mostly of redundant nodes is not kept. What is kept
-// then grows with the area seen, not with the time spent (a node's pose and edges, ~1 KB, remain).
+// stays anchored to the old map), but once the local map and its submap no longer need it, its
+// scan and match points are freed (so the map, when rebuilt, no longer counts what it saw), and a
+// submap made mostly of redundant nodes is not kept. What is kept then grows with the area seen,
+// not with the time spent (a node's pose and edges, ~1 KB, remain).
 //
 // Frames and units: as slam_backend.h.
 #pragma once
@@ -188,9 +189,9 @@ class GraphSlam : public SlamBackend {
   std::vector<TrackedScan> scans_;
   std::deque<int> pending_;  // nodes not yet searched for closures
   std::deque<int> redundant_;  // redundant nodes whose scans are still held, oldest first
-  int submapped_upto_ = -1;
+  int submapped_upto_ = -1;  // last node whose submap has been built (or skipped) and searched
   int unsolved_ = 0;         // closures added since the last solve that did not ask for one
-  static constexpr int kMaxUnsolved = 10;  // after this many, they are solved anyway    // last node whose submap has been built (or skipped) and searched
+  static constexpr int kMaxUnsolved = 10;  // after this many, they are solved anyway
   // Submap grids whose pooled levels are kept, most recently matched first (closure thread only).
   static constexpr int kPyramidCache = 16;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
