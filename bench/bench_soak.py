@@ -22,6 +22,7 @@ node deaths. Run inside the devel environment (make bench does that).
 import json
 import os
 import re
+import signal
 import socket
 import subprocess
 import sys
@@ -86,7 +87,14 @@ def memory_picture(samples, path):
                 'resident memory [MB] against simulated time [min]', path, size=(900, 450), marker_x=WARM_UP / 60.0)
 
 
+def _terminated(signum, _frame):
+    raise SystemExit('bench_soak: stopped by signal %d' % signum)
+
+
 def main():
+    # SIGTERM (kill, a CI timeout) ends Python without its finally blocks: the launches and their
+    # nodes would be left running and join the next soak's master on the same port.
+    signal.signal(signal.SIGTERM, _terminated)
     out = os.path.join(HERE, 'out', 'soak')
     os.makedirs(out, exist_ok=True)
     env = dict(os.environ)

@@ -20,6 +20,7 @@ left the robot.
    move_base aborts the goal saying why, slam_gmapping starts a new map, no node dies or stops
    answering, and the next goal is reached.
 """
+import contextlib
 import math
 import os
 import signal
@@ -44,6 +45,25 @@ from mbot_slam_navigation.transforms import yaw_to_quaternion
 from rviz_screen import wait_for
 
 SILENCE = 5.0  # [s simulated] the laser's silence
+
+
+@contextlib.contextmanager
+def random_navigation(*args):
+    """`rosrun random_navigation.py ARGS` as a user runs it; yields (process, its output lines so
+    far). On leaving, a script still running is stopped with SIGINT (as Ctrl-C) and its output read
+    to the end."""
+    nav = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'random_navigation.py', '__name:=random_navigation']
+                           + list(args), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    out = []
+    reader = threading.Thread(target=lambda: out.extend(nav.stdout), daemon=True)
+    reader.start()
+    try:
+        yield nav, out
+    finally:
+        if nav.poll() is None:
+            nav.send_signal(signal.SIGINT)
+            nav.wait(timeout=30)
+        reader.join(timeout=5)
 
 
 def node_pid(name):
@@ -156,22 +176,11 @@ class NavigationFaultsTest(unittest.TestCase):
         points = os.path.join(os.environ.get('ROS_HOME', '/tmp'), 'faults_points.yaml')
         with open(points, 'w') as f:
             f.write('visitor_spot: {position: [%.2f, %.2f], yaw: 0.0}\n' % goal)
-        nav = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'random_navigation.py', '_max_goals:=1',
-                                '_locations_file:=' + points, '__name:=random_navigation'], stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True)
-        out = []
-        reader = threading.Thread(target=lambda: out.extend(nav.stdout), daemon=True)
-        reader.start()
-        try:
+        with random_navigation('_max_goals:=1', '_locations_file:=' + points) as (nav, out):
             self.assertTrue(wait_for(lambda: any('as occupied' in l for l in out), 240.0),
                             'random_navigation did not say the goal was occupied:\n' + ''.join(out)[-3000:])
             self.assertTrue(delete(model_name='visitor').success)
             nav.wait(timeout=600)
-        finally:
-            if nav.poll() is None:
-                nav.send_signal(signal.SIGINT)
-                nav.wait(timeout=30)
-        reader.join(timeout=5)
         text = ''.join(out)
         self.assertIn('Random navigation summary: 1 goals, 1 succeeded', text, text[-3000:])
 
@@ -204,14 +213,7 @@ class NavigationFaultsTest(unittest.TestCase):
             self.assertTrue(delete(model_name='broad_visitor').success)
 
     def test_3_move_base_killed_mid_goal_is_respawned_and_random_navigation_goes_on(self):
-        env = dict(os.environ)
-        nav = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'random_navigation.py', '_max_goals:=3', '_seed:=2',
-                                '__name:=random_navigation'], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               text=True)
-        out = []
-        reader = threading.Thread(target=lambda: out.extend(nav.stdout), daemon=True)
-        reader.start()
-        try:
+        with random_navigation('_max_goals:=3', '_seed:=2') as (nav, out):
             self.assertTrue(wait_for(lambda: any('Going to' in l for l in out), 120.0), 'random_navigation sent no goal')
             rospy.sleep(3.0)
             old = node_pid('/move_base')
@@ -219,11 +221,6 @@ class NavigationFaultsTest(unittest.TestCase):
             respawned = wait_for(lambda: self.try_pid('/move_base') not in (None, old), 120.0)
             self.assertTrue(respawned, 'move_base was not started again')
             nav.wait(timeout=900)
-        finally:
-            if nav.poll() is None:
-                nav.send_signal(signal.SIGINT)
-                nav.wait(timeout=30)
-        reader.join(timeout=5)
         text = ''.join(out)
         self.assertEqual(nav.returncode, 0, text[-3000:])
         self.assertIn('sending the goal to', text, 'random_navigation did not say it sent the goal again')
