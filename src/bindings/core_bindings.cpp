@@ -473,6 +473,9 @@ PYBIND11_MODULE(_core, m) {
              d["trimmed_nodes"] = st.trimmed_nodes;
              d["submaps"] = st.submaps;
              d["submaps_skipped"] = st.submaps_skipped;
+             d["submap_bytes"] = st.submap_bytes;
+             d["closures_accepted"] = st.closures_accepted;
+             d["merged_nodes"] = st.merged_nodes;
              d["closures_unsolved"] = st.closures_unsolved;
              return d;
            })

@@ -11,6 +11,8 @@
 #include <pthread.h>
 #endif
 
+#include <Eigen/LU>  // Matrix3d::inverse
+
 #include "mbot_slam_navigation/core/pose2d.h"
 
 namespace mbot {
@@ -135,7 +137,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       pose = composePose(nodes_.back().pose, z);
       edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
     }
-    const bool redundant = !first && redundantLocked(pose);
+    const bool redundant = !first && redundantLocked(pose, seesAllRound(scan));
     nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points, redundant});
     if (redundant) {
       redundant_.push_back(index);
@@ -156,13 +158,19 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
   return true;
 }
 
-bool GraphSlam::redundantLocked(const Eigen::Vector3d& pose) const {
+bool GraphSlam::seesAllRound(const LaserScan& scan) {
+  const double step = std::abs(scan.angle_increment_rad);
+  return step * static_cast<double>(scan.ranges_m.size()) >= 2.0 * M_PI - 0.5 * step;
+}
+
+bool GraphSlam::redundantLocked(const Eigen::Vector3d& pose, bool all_round) const {
   if (params_.redundant_distance <= 0.0) return false;
   const double d2 = params_.redundant_distance * params_.redundant_distance;
   for (const Node& n : nodes_) {
-    if (n.redundant || !n.points) continue;
+    if (n.redundant || !n.scan) continue;
+    // A laser that sees all round sees the same from one place whatever the heading.
     if ((n.pose.head<2>() - pose.head<2>()).squaredNorm() <= d2 &&
-        std::abs(normalizeAngle(n.pose.z() - pose.z())) <= params_.redundant_angle) {
+        (all_round || std::abs(normalizeAngle(n.pose.z() - pose.z())) <= params_.redundant_angle)) {
       return true;
     }
   }
@@ -173,13 +181,45 @@ void GraphSlam::trimLocked() {
   // The local map holds the last local_map_nodes nodes; a node's submap is built, and the node
   // searched for closures, by the time submapped_upto_ passes it.
   const int local_first = static_cast<int>(nodes_.size()) - params_.local_map_nodes;
-  while (!redundant_.empty() && redundant_.front() < local_first && redundant_.front() <= submapped_upto_) {
-    Node& n = nodes_[redundant_.front()];
-    n.scan.reset();
-    n.points.reset();
+  const int done = std::min(local_first - 1, submapped_upto_);
+  // Match points serve only the local map, the submap and the closure search: no node needs them
+  // after (the map is registered from the scans).
+  while (released_upto_ < done) nodes_[++released_upto_].points.reset();
+  while (!redundant_.empty() && redundant_.front() <= done) {
+    const int k = redundant_.front();
+    nodes_[k].scan.reset();
     redundant_.pop_front();
     ++stats_.trimmed_nodes;
+    if (!nodes_[k].anchor) mergeLocked(k);
   }
+}
+
+void GraphSlam::mergeLocked(int k) {
+  auto in = std::find_if(edges_.begin(), edges_.end(), [k](const PoseGraphEdge& e) { return !e.robust && e.to == k; });
+  auto out = std::find_if(edges_.begin(), edges_.end(), [k](const PoseGraphEdge& e) { return !e.robust && e.from == k; });
+  if (in == edges_.end() || out == edges_.end()) return;
+  // z = z1 (+) z2: t = t1 + R(th1) t2, th = th1 + th2. First-order covariance: J1 S1 J1' + J2 S2 J2'.
+  const Eigen::Vector3d z1 = in->measurement, z2 = out->measurement;
+  const double c = std::cos(z1.z()), s = std::sin(z1.z());
+  const Eigen::Vector2d rt2(c * z2.x() - s * z2.y(), s * z2.x() + c * z2.y());
+  Eigen::Matrix3d j1 = Eigen::Matrix3d::Identity(), j2 = Eigen::Matrix3d::Identity();
+  j1(0, 2) = -rt2.y();
+  j1(1, 2) = rt2.x();
+  j2.topLeftCorner<2, 2>() << c, -s, s, c;
+  const Eigen::Matrix3d cov = j1 * in->information.inverse() * j1.transpose() + j2 * out->information.inverse() * j2.transpose();
+  const int from = in->from, to = out->to;
+  in->to = to;
+  in->measurement = composePose(z1, z2);
+  in->information = cov.inverse();
+  edges_.erase(out);
+  edges_.erase(std::remove_if(edges_.begin(), edges_.end(),
+                              [k](const PoseGraphEdge& e) { return e.robust && (e.to == k || e.from == k); }),
+               edges_.end());
+  Node& n = nodes_[k];
+  n.parent = from;
+  n.offset = relativePose(nodes_[from].pose, n.pose);
+  ++stats_.merged_nodes;
+  (void)to;
 }
 
 void GraphSlam::rebuildLocalMapLocked() {
@@ -259,6 +299,7 @@ void GraphSlam::buildSubmap(int first, int last) {
       ++stats_.submaps_skipped;
       return;
     }
+    nodes_[first].anchor = true;  // the submap's frame: never merged
     const Eigen::Vector3d& anchor = nodes_[first].pose;
     for (int k = first; k <= last; ++k) appendMoved(*nodes_[k].points, relativePose(anchor, nodes_[k].pose), points);
   }
@@ -310,17 +351,10 @@ bool GraphSlam::searchClosures(int n) {
 
   bool added = false;
   for (const Candidate& c : candidates) {
-    // The pooled levels of a submap are 7 times its grid: keep them for the submaps matched
-    // lately (the robot is likely to be there again next node), free the others.
-    pyramids_.remove(c.grid);
-    pyramids_.push_front(c.grid);
-    if (static_cast<int>(pyramids_.size()) > kPyramidCache) {
-      pyramids_.back()->dropLevels();
-      pyramids_.pop_back();
-    }
     const Eigen::Vector3d init = relativePose(c.anchor, pose);
     const MatchWindow window{radius, params_.loop_search_angle};
     const MatchResult found = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_min_response);
+    cachePyramid(c.grid);
     int ambiguous = 0;
     Eigen::Vector3d refined;
     double score = 0.0;
@@ -340,6 +374,7 @@ bool GraphSlam::searchClosures(int n) {
       continue;
     }
     edges_.push_back({c.anchor_index, n, refined, edgeInformation(1.0), true});
+    ++stats_.closures_accepted;
     last_closure_travelled_ = travelled;
     const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);
     if (err.dot(edges_.back().information * err) > params_.loop_solve_chi2) {
@@ -351,26 +386,65 @@ bool GraphSlam::searchClosures(int n) {
   return added;
 }
 
+void GraphSlam::cachePyramid(const std::shared_ptr<const LikelihoodGrid>& grid) {
+  // The pooled levels of a submap are several times its grid: keep them for the submaps matched
+  // lately (the robot is likely to be there again next node) within kPyramidBytes, free the others.
+  pyramids_.remove(grid);
+  pyramids_.push_front(grid);
+  std::size_t held = 0;
+  for (auto it = pyramids_.begin(); it != pyramids_.end();) {
+    held += (*it)->bytes();
+    if (it != pyramids_.begin() && held > kPyramidBytes) {
+      held -= (*it)->bytes();
+      (*it)->dropLevels();
+      it = pyramids_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t total = 0;
+  for (const Submap& s : submaps_) total += s.grid->bytes();
+  stats_.submap_bytes = total;
+}
+
 void GraphSlam::optimize() {
   const auto t0 = std::chrono::steady_clock::now();
+  // The live nodes (not merged) are solved; live[i] is the node index of pose i.
   std::vector<Eigen::Vector3d> poses;
-  std::vector<PoseGraphEdge> edges;
+  std::vector<int> live;
+  std::vector<PoseGraphEdge> edges, original;
+  std::size_t n0;  // nodes at the snapshot
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    poses.reserve(nodes_.size());
-    for (const Node& node : nodes_) poses.push_back(node.pose);
-    edges = edges_;
+    n0 = nodes_.size();
+    std::vector<int> index_of(n0, -1);
+    for (std::size_t k = 0; k < n0; ++k) {
+      if (nodes_[k].parent >= 0) continue;
+      index_of[k] = static_cast<int>(live.size());
+      live.push_back(static_cast<int>(k));
+      poses.push_back(nodes_[k].pose);
+    }
+    edges.reserve(edges_.size());
+    for (const PoseGraphEdge& e : edges_) {
+      if (index_of[e.from] < 0 || index_of[e.to] < 0) continue;  // cannot happen: merged nodes have no edges
+      original.push_back(e);
+      edges.push_back(e);
+      edges.back().from = index_of[e.from];
+      edges.back().to = index_of[e.to];
+    }
   }
   const std::vector<Eigen::Vector3d> before = poses;
   PoseGraphOptions options;
   options.cauchy_scale = params_.cauchy_scale;
   optimizePoseGraph(poses, edges, options);
-  std::vector<std::pair<int, int>> rejected;
+  std::vector<std::pair<int, int>> rejected;  // node indices
   std::vector<PoseGraphEdge> kept;
-  for (const auto& e : edges) {
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const PoseGraphEdge& e = edges[i];
     const Eigen::Vector3d err = edgeError(poses[e.from], poses[e.to], e.measurement);
     if (e.robust && err.dot(e.information * err) > params_.loop_reject_chi2) {
-      rejected.emplace_back(e.from, e.to);
+      rejected.emplace_back(original[i].from, original[i].to);
     } else {
       kept.push_back(e);
     }
@@ -382,11 +456,17 @@ void GraphSlam::optimize() {
   bool moved = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const std::size_t n0 = poses.size();
-    // Nodes added while optimizing move rigidly with the last optimized node.
-    const Eigen::Vector3d correction = composePose(poses[n0 - 1], inversePose(nodes_[n0 - 1].pose));
+    std::vector<int> index_of(n0, -1);
+    for (std::size_t i = 0; i < live.size(); ++i) index_of[live[i]] = static_cast<int>(i);
+    // Nodes added while optimizing move rigidly with the last optimized node (the newest nodes are
+    // never merged); merged nodes move with their parent, which comes before them.
+    const int last = live.back();
+    const Eigen::Vector3d correction = composePose(poses.back(), inversePose(nodes_[last].pose));
     for (std::size_t k = 0; k < nodes_.size(); ++k) {
-      const Eigen::Vector3d updated = k < n0 ? poses[k] : composePose(correction, nodes_[k].pose);
+      const Node& node = nodes_[k];
+      const Eigen::Vector3d updated = node.parent >= 0 ? composePose(nodes_[node.parent].pose, node.offset)
+                                      : k < n0          ? poses[index_of[k]]
+                                                        : composePose(correction, node.pose);
       moved = moved || (updated.head<2>() - nodes_[k].pose.head<2>()).norm() > 0.5 * params_.delta ||
               std::abs(normalizeAngle(updated.z() - nodes_[k].pose.z())) > 0.5 * M_PI / 180.0;
       nodes_[k].pose = updated;

@@ -18,6 +18,7 @@
 #include <mutex>
 #include <thread>
 
+#include <malloc.h>
 #include <pthread.h>
 
 #include <geometry_msgs/TransformStamped.h>
@@ -265,6 +266,28 @@ class SlamGmappingNode {
       publishMap(msg->header.stamp);
       last_map_update_ = msg->header.stamp;
     }
+    logSummary(msg->header.stamp);
+  }
+
+  // One line every kSummaryPeriod of (simulated) time: what the graph holds, so that a user who
+  // leaves the robot running sees whether it keeps growing.
+  void logSummary(const ros::Time& stamp) {
+    if (!last_summary_.isZero() && (stamp - last_summary_).toSec() < kSummaryPeriod) return;
+    if (last_summary_.isZero()) {
+      last_summary_ = stamp;
+      return;
+    }
+    last_summary_ = stamp;
+    const auto* graph = dynamic_cast<const mbot::core::GraphSlam*>(slam_.get());
+    if (!graph) return;
+    const mbot::core::GraphSlamStats s = graph->stats();
+    struct mallinfo2 heap = mallinfo2();
+    ROS_INFO("slam_gmapping: %d nodes (%d revisits, %d of them with their scan freed, %d out of the optimization), "
+             "%d submaps (%.1f MB), %d loop closures (%d in the graph), %d optimizations (last %.0f ms); "
+             "heap %.1f MB in use, %.1f MB free",
+             s.nodes, s.redundant_nodes, s.trimmed_nodes, s.merged_nodes, s.submaps, s.submap_bytes / 1e6,
+             s.closures_accepted, s.loop_closures, s.optimizations, s.last_optimization_ms,
+             (heap.uordblks + heap.hblkhd) / 1e6, heap.fordblks / 1e6);
   }
 
   // map -> odom as estimated from the scan at `stamp`, stamped with it, so that map -> base at the
@@ -335,10 +358,15 @@ class SlamGmappingNode {
     map.header.frame_id = map_frame_;
     map.header.stamp = stamp;
     map.info.map_load_time = stamp;
-    std::lock_guard<std::mutex> lock(map_mutex_);
-    last_map_ = map;
-    map_pub_.publish(map);
-    meta_pub_.publish(map.info);
+    {
+      std::lock_guard<std::mutex> lock(map_mutex_);
+      last_map_ = map;
+      map_pub_.publish(map);
+      meta_pub_.publish(map.info);
+    }
+    // A map rebuild and an optimization allocate and free megabytes; glibc keeps freed pages in
+    // the middle of the heap, so a node left running for hours would show its peaks, not its use.
+    malloc_trim(0);
   }
 
   bool onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
@@ -407,6 +435,8 @@ class SlamGmappingNode {
   nav_msgs::OccupancyGrid last_map_;
   ros::Time last_stamp_, last_map_update_;
   long scan_count_ = 0;
+  static constexpr double kSummaryPeriod = 300.0;  // [s]
+  ros::Time last_summary_;
   std::thread tf_thread_;
 };
 

@@ -98,3 +98,44 @@ def test_free_running_stays_free_alone_and_turns_auto_when_a_node_falls_behind()
     run(p, 0.5, lambda rtf: 30.0, rtf_reached=120.0, wall0=11.0, sim0=1400.0)  # 30 s behind
     assert p.went_auto and p.auto and math.isinf(p.max_rtf)
     assert p.rtf < 120.0  # slowed from what it reached
+
+
+def test_auto_waits_for_a_late_node_at_most_max_hold_and_a_fixed_factor_never_waits():
+    # move_base's heartbeats carry its pose's stamp every 0.1 simulated s; the clock may run
+    # interval + max_lag past the last one, then waits for the next (at most max_hold wall s).
+    p = make_pacer('auto', max_lag=0.15)
+    for k in range(10):
+        p.heartbeat('/move_base', 0.02, wall=0.01 * k, stamp=0.1 * k)
+    assert abs(p.heard['/move_base'].interval - 0.1) < 1e-9
+    assert p.late(1.14, wall=0.1) is None              # 0.9 + 0.1 + 0.15 = 1.15
+    assert p.late(1.16, wall=0.1) == '/move_base'
+    assert p.late(1.16, wall=0.15) == '/move_base' and p.holds == 1
+    p.heartbeat('/move_base', 0.26, wall=0.16, stamp=1.0)  # it came: go on to 1.25
+    assert p.late(1.16, wall=0.16) is None and p.held_s > 0.05
+    assert p.late(1.26, wall=0.17) == '/move_base'
+    assert p.late(1.26, wall=0.17 + p.max_hold + 0.01) is None  # passed by, not a deadlock
+    assert p.passed_by == 1 and p.late(5.0, wall=0.3) is None
+    p.heartbeat('/move_base', 0.02, wall=0.35, stamp=1.1)   # back in its rhythm: waited for again
+    assert p.late(1.5, wall=0.36) == '/move_base'
+    assert p.late(1.5, wall=0.36 + p.forget_after + 0.1) is None  # silent: forgotten
+
+    never = make_pacer('auto', max_hold=0.0)
+    for k in range(10):
+        never.heartbeat('/move_base', 0.02, wall=0.01 * k, stamp=0.1 * k)
+    assert never.late(100.0, wall=0.1) is None
+    with pytest.raises(PacingError, match='~max_hold'):
+        make_pacer('auto', max_hold=-0.1)
+
+    fixed = make_pacer(4.0)
+    for k in range(10):
+        fixed.heartbeat('/move_base', 0.02, wall=0.01 * k, stamp=0.1 * k)
+    assert fixed.late(100.0, wall=0.1) is None
+
+
+def test_time_going_back_restarts_a_nodes_rhythm():
+    p = make_pacer('auto', max_lag=0.15)
+    for k in range(5):
+        p.heartbeat('/slam_gmapping', 0.0, wall=0.01 * k, stamp=100.0 + 0.1 * k)
+    p.heartbeat('/slam_gmapping', 0.0, wall=0.06, stamp=0.1)  # reset_simulation
+    assert p.heard['/slam_gmapping'].stamp == 0.1
+    assert p.late(0.3, wall=0.07) is None and p.late(0.36, wall=0.07) == '/slam_gmapping'

@@ -31,12 +31,16 @@
 // node by more than half a cell or 0.5 degree.
 //
 // A robot left running in one home revisits the same places for hours; memory must not grow with
-// time. A new node within redundant_distance and redundant_angle of an older node that keeps its
-// scan is redundant: it joins the chain and is matched against the nearest submap (so the robot
-// stays anchored to the old map), but once the local map and its submap no longer need it, its
-// scan and match points are freed (so the map, when rebuilt, no longer counts what it saw), and a
-// submap made mostly of redundant nodes is not kept. What is kept then grows with the area seen,
-// not with the time spent (a node's pose and edges, ~1 KB, remain).
+// time. A new node within redundant_distance of an older node that keeps its scan, and within
+// redundant_angle of its heading (any heading if the laser sees all round), is redundant: it joins
+// the chain and is matched against the nearest submap (so the robot stays anchored to the old
+// map), but once the local map and its submap no longer need it, its scan is freed (so the map,
+// when rebuilt, no longer counts what it saw), and a submap made mostly of redundant nodes is not
+// kept. Match points are freed from every node at that point. The trimmed node then leaves the
+// optimization too: its two chain edges become one (the measurements composed, the covariances
+// propagated) and its closures are dropped (they only tied a revisit to a map that other nodes
+// hold); it keeps its pose relative to the node before it, and moves with it. What is kept and
+// solved then grows with the area seen, not with the time spent (a merged node's ~0.1 KB remains).
 //
 // Frames and units: as slam_backend.h.
 #pragma once
@@ -91,10 +95,10 @@ struct GraphSlamParams {
   /// for 3 degrees of freedom) do not trigger a solve (`~loop_solve_chi2`); 0 solves after every closure.
   double loop_solve_chi2 = 7.8;
   /// [m] a new node this close to an older node that keeps its scan (and within redundant_angle of
-  /// its heading) keeps its scan only while the local map and its submap need it
-  /// (`~redundant_distance`); 0 keeps every node's scan.
+  /// its heading, unless the laser sees all round) keeps its scan only while the local map and its
+  /// submap need it (`~redundant_distance`); 0 keeps every node's scan.
   double redundant_distance = 0.3;
-  double redundant_angle = 0.5;     ///< [rad] (`~redundant_angle`)
+  double redundant_angle = 0.5;     ///< [rad] (`~redundant_angle`; not used for a laser that sees all round)
   /// Keep every scan's tracked pose for scanPoses() (offline scoring; 40 bytes a scan, so the node
   /// turns it off).
   bool keep_scan_poses = true;
@@ -108,6 +112,8 @@ struct GraphSlamStats {
   int local_match_failures = 0;     ///< nodes left at the odometry prediction
   int loop_attempts = 0;            ///< submap matches tried
   int loop_closures = 0;            ///< closure edges in the graph
+  int closures_accepted = 0;        ///< closures ever accepted (some since dropped with merged nodes)
+  int merged_nodes = 0;             ///< trimmed nodes taken out of the optimization
   int loop_rejected_ambiguous = 0;
   int loop_rejected_inconsistent = 0;  ///< removed after optimization
   int optimizations = 0;
@@ -118,6 +124,7 @@ struct GraphSlamStats {
   int trimmed_nodes = 0;            ///< of those, nodes whose scan and points are freed
   int submaps = 0;                  ///< submaps kept for closures
   int submaps_skipped = 0;          ///< submaps not kept (mostly redundant nodes)
+  std::size_t submap_bytes = 0;     ///< the kept submaps' grids with the pooled levels cached
 };
 
 class GraphSlam : public SlamBackend {
@@ -151,8 +158,11 @@ class GraphSlam : public SlamBackend {
     double time_s;
     double travelled_m;     // odometry path length from the first node
     std::shared_ptr<const LaserScan> scan;  // null once trimmed
-    std::shared_ptr<const std::vector<Eigen::Vector2d>> points;  // match points, base frame; null once trimmed
+    std::shared_ptr<const std::vector<Eigen::Vector2d>> points;  // match points, base frame; null once no longer needed
     bool redundant;          // an older node that keeps its scan saw the same place
+    bool anchor = false;     // the first node of a kept submap (never merged)
+    int parent = -1;         // merged: the live node before it, which it moves with
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // merged: its pose in the parent's frame
   };
   struct TrackedScan {
     double time_s;
@@ -171,10 +181,20 @@ class GraphSlam : public SlamBackend {
   /// edge that the current estimate does not already satisfy (loop_solve_chi2).
   bool searchClosures(int node);
   void buildSubmap(int first, int last);
-  /// Whether a node at `pose` would repeat an older node that keeps its scan (mutex_ held).
-  bool redundantLocked(const Eigen::Vector3d& pose) const;
-  /// Frees the scans of redundant nodes that neither the local map nor a submap still needs (mutex_ held).
+  /// Whether a node at `pose` would repeat an older node that keeps its scan: within
+  /// redundant_distance, and within redundant_angle of its heading unless the laser sees
+  /// `all_round` (mutex_ held).
+  bool redundantLocked(const Eigen::Vector3d& pose, bool all_round) const;
+  /// Whether the scan's beams cover the full circle.
+  static bool seesAllRound(const LaserScan& scan);
+  /// Frees the match points of nodes that neither the local map nor a submap still needs, and the
+  /// scans of such nodes that are redundant, which then leave the optimization (mutex_ held).
   void trimLocked();
+  /// Takes trimmed node `k` out of the optimization: its chain edges joined, its closures dropped
+  /// (mutex_ held).
+  void mergeLocked(int k);
+  /// Moves `grid` to the front of pyramids_ and frees the pooled levels of those past the budget.
+  void cachePyramid(const std::shared_ptr<const LikelihoodGrid>& grid);
   void optimize();
   Eigen::Matrix3d edgeInformation(double scale) const;
 
@@ -190,10 +210,12 @@ class GraphSlam : public SlamBackend {
   std::deque<int> pending_;  // nodes not yet searched for closures
   std::deque<int> redundant_;  // redundant nodes whose scans are still held, oldest first
   int submapped_upto_ = -1;  // last node whose submap has been built (or skipped) and searched
+  int released_upto_ = -1;   // last node whose match points have been freed
   int unsolved_ = 0;         // closures added since the last solve that did not ask for one
   static constexpr int kMaxUnsolved = 10;  // after this many, they are solved anyway
-  // Submap grids whose pooled levels are kept, most recently matched first (closure thread only).
-  static constexpr int kPyramidCache = 16;
+  // Submap grids whose pooled levels are kept, most recently matched first (closure thread only),
+  // and the bytes they may hold (grids and levels; the most recent is kept whatever its size).
+  static constexpr std::size_t kPyramidBytes = 4u << 20;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
   GraphSlamStats stats_;  // counters; nodes and loop_closures are derived in stats()

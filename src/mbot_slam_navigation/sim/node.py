@@ -3,7 +3,8 @@
 Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
 'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
 min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.15 simulated s:
-the lag of the slowest node that auto aims below; defaults in sim/pacing.py), step_size (0.01 s),
+the lag of the slowest node that auto aims below; defaults in sim/pacing.py), max_hold (0.1 wall s:
+under auto, the longest the clock waits for a node whose heartbeat is due; 0 never waits), step_size (0.01 s),
 pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false), odometry_slip_stddev
 (0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace
 ("gazebo": where services and the contacts topic live).
@@ -85,7 +86,8 @@ class SimNode:
         self.pacer = make_pacer(rospy.get_param('~real_time_factor', 1.0),
                                 min_rtf=float(rospy.get_param('~min_real_time_factor', pacing.MIN_RTF)),
                                 max_rtf=float(rospy.get_param('~max_real_time_factor', pacing.MAX_RTF)),
-                                max_lag=float(rospy.get_param('~max_lag', pacing.MAX_LAG)))
+                                max_lag=float(rospy.get_param('~max_lag', pacing.MAX_LAG)),
+                                max_hold=float(rospy.get_param('~max_hold', pacing.MAX_HOLD)))
         step = float(rospy.get_param('~step_size', 0.01))
         clock_hz = float(rospy.get_param('~pub_clock_frequency', 100.0))
         self.paused = bool(rospy.get_param('~paused', False))
@@ -241,9 +243,10 @@ class SimNode:
 
     def on_heartbeat(self, msg):
         """A consumer of simulated time says how far it has got (sim/pacing.py)."""
-        lag = self.sim.time - msg.stamp.to_sec()
+        stamp = msg.stamp.to_sec()
+        lag = self.sim.time - stamp
         with self.pacer_lock:
-            self.pacer.heartbeat(msg.frame_id or '(unnamed)', lag, time.monotonic())
+            self.pacer.heartbeat(msg.frame_id or '(unnamed)', lag, time.monotonic(), stamp)
 
     def pace(self, now: float, wall0: float, sim0: float):
         """Sleeps as the real-time factor requires; returns the (wall, sim) pair to pace from."""
@@ -260,8 +263,10 @@ class SimNode:
                                   '~min_real_time_factor/~max_real_time_factor)' % (p.worst[1], p.worst[0]))
                 if p.auto and wall - self.last_report >= 10.0:
                     self.last_report = wall
-                    rospy.loginfo('gazebo_sim: running at %.1fx real time (auto%s)' % (
-                        p.achieved, '; slowest: %s %.2f s behind' % p.worst if p.worst[0] else '; no node reports lag'))
+                    rospy.loginfo('gazebo_sim: running at %.1fx real time (auto%s; waited %.1f s for late nodes, %d '
+                                  'times, passed one by after %.2f s %d times)' % (
+                                      p.achieved, '; slowest: %s %.2f s behind' % p.worst if p.worst[0]
+                                      else '; no node reports lag', p.held_s, p.holds, p.max_hold, p.passed_by))
             rtf = p.rtf
         if decided:
             return wall, now  # pace the new factor from here
@@ -354,6 +359,11 @@ class SimNode:
                 wall0, sim0 = time.monotonic(), self.sim.time
                 with self.pacer_lock:
                     self.pacer.restart(wall0, sim0)
+                continue
+            with self.pacer_lock:
+                late = self.pacer.late(self.sim.time + self.sim.step_size, time.monotonic())
+            if late is not None:
+                time.sleep(0.001)  # its heartbeat is due: a few wall ms at most (pacing.py)
                 continue
             with self.lock:
                 contacts = self.sim.step()

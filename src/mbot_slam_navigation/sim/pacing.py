@@ -13,6 +13,15 @@ sets the factor: above `max_lag` it falls in proportion (at most halved), below 
 factor rises by `increase` per period, up to `max_rtf`; with no heartbeat at all it rises to the
 maximum. A factor of inf means "as fast as the simulator goes" (no sleeping).
 
+The factor follows the lag over a quarter of a wall second, which at 12x is three simulated
+seconds: a node starved of the CPU for 30 ms of wall time (the scheduler on a busy two-core
+machine) falls 0.4 simulated s behind before any factor could react, and move_base would find its
+transform older than transform_tolerance. So under auto the simulator also waits for a node that is
+late: each node's heartbeats come every `interval` simulated seconds (measured), and the clock does
+not pass the node's last stamp + interval + max_lag until its next heartbeat has come, for at most
+`max_hold` wall seconds (a node that changed its rhythm or stopped is then passed by, until it
+beats again).
+
 Free-running (real_time_factor 0) stays free while nobody reports a lag; once a node is more than
 `free_lag_limit` behind, the pacer turns to auto with no upper bound (`went_auto` says when), so a
 stack started at 0 still works, as fast as it keeps up.
@@ -26,6 +35,7 @@ AUTO = 'auto'
 MIN_RTF = 0.25      # ~min_real_time_factor [sim s / wall s]
 MAX_RTF = 100.0     # ~max_real_time_factor
 MAX_LAG = 0.15      # ~max_lag [simulated s]: half of move_base's usual transform_tolerance (0.3 s)
+MAX_HOLD = 0.1      # ~max_hold [wall s]: the longest auto waits for a late node (0: never)
 
 
 class PacingError(ValueError):
@@ -36,6 +46,9 @@ class PacingError(ValueError):
 class _Heard:
     lag: float = 0.0       # [simulated s] worst lag since the last adjustment
     last_wall: float = 0.0  # [wall s] when the last heartbeat arrived
+    stamp: float = -math.inf  # [simulated s] the newest stamp heard
+    interval: float = 0.0  # [simulated s] usual time between its stamps (0: not known yet)
+    passed: bool = False   # waited for max_hold without a heartbeat: not waited for until the next
 
 
 @dataclass
@@ -54,16 +67,54 @@ class Pacer:
     worst: Tuple[str, float] = ('', 0.0)  # the node with the worst lag in the last period, and its lag
     free_lag_limit: float = 1.0      # [simulated s] a lag that turns free-running into auto
     went_auto: bool = False          # set when free-running turned into auto
+    max_hold: float = MAX_HOLD       # [wall s] the longest the clock waits for a late node (0: never)
+    held_s: float = 0.0              # [wall s] spent waiting for late nodes, in all
+    holds: int = 0                   # times the clock waited
+    passed_by: int = 0               # times a node was passed by after max_hold
     _mark: Optional[Tuple[float, float]] = None  # (wall, sim) at the last adjustment
+    _hold: Optional[Tuple[str, float]] = None    # (node, wall) of the wait under way
 
-    def heartbeat(self, node: str, lag: float, wall: float) -> None:
-        """A node's heartbeat arrived at `wall` [s] with the clock `lag` [simulated s] past its stamp."""
+    def heartbeat(self, node: str, lag: float, wall: float, stamp: Optional[float] = None) -> None:
+        """A node's heartbeat arrived at `wall` [s] with the clock `lag` [simulated s] past its
+        `stamp` [simulated s; given for the waiting of late nodes]."""
         h = self.heard.setdefault(node, _Heard())
         if wall - h.last_wall > self.adjust_period:
             h.lag = lag  # first beat of this period
         else:
             h.lag = max(h.lag, lag)
         h.last_wall = wall
+        h.passed = False
+        if stamp is not None:
+            gap = stamp - h.stamp
+            if 0.0 < gap <= 1.0:  # longer: the node paused (no goal) or time jumped
+                h.interval = gap if h.interval == 0.0 else 0.8 * h.interval + 0.2 * gap
+            h.stamp = max(h.stamp, stamp) if gap > -1.0 else stamp  # time went back: start again
+
+    def late(self, sim_next: float, wall: float) -> Optional[str]:
+        """Under auto, the node that the clock should wait for before it goes on to `sim_next`
+        [simulated s], or None. Counts the waiting; after max_hold wall seconds the node is passed by."""
+        if not self.auto or self.max_hold <= 0.0:
+            return None
+        for node, h in self.heard.items():
+            if h.passed or h.interval == 0.0 or wall - h.last_wall > self.forget_after:
+                continue
+            if sim_next > h.stamp + h.interval + self.max_lag:
+                if self._hold is None or self._hold[0] != node:
+                    self._hold = (node, wall)
+                    self.holds += 1
+                if wall - self._hold[1] > self.max_hold:
+                    h.passed = True
+                    self.passed_by += 1
+                    self._end_hold(wall)
+                    continue
+                return node
+        self._end_hold(wall)
+        return None
+
+    def _end_hold(self, wall: float) -> None:
+        if self._hold is not None:
+            self.held_s += wall - self._hold[1]
+            self._hold = None
 
     def restart(self, wall: float, sim: float) -> None:
         """Time jumped (reset_simulation) or was paused: measure from here."""
@@ -98,7 +149,8 @@ class Pacer:
         return True
 
 
-def make_pacer(real_time_factor, min_rtf: float = MIN_RTF, max_rtf: float = MAX_RTF, max_lag: float = MAX_LAG) -> Pacer:
+def make_pacer(real_time_factor, min_rtf: float = MIN_RTF, max_rtf: float = MAX_RTF, max_lag: float = MAX_LAG,
+               max_hold: float = MAX_HOLD) -> Pacer:
     """The pacer for the simulator's ~real_time_factor: a number >= 0 (0: as fast as possible) or
     'auto' (start at 1x, within [min_rtf, max_rtf]). Raises PacingError naming the parameter."""
     if not (min_rtf > 0 and max_rtf >= min_rtf):
@@ -106,13 +158,16 @@ def make_pacer(real_time_factor, min_rtf: float = MIN_RTF, max_rtf: float = MAX_
                           % (min_rtf, max_rtf))
     if not max_lag > 0:
         raise PacingError('~max_lag must be > 0 simulated seconds (got %r)' % max_lag)
+    if not (0 <= max_hold <= 5.0):
+        raise PacingError('~max_hold must lie in [0, 5] wall seconds (got %r)' % max_hold)
     if isinstance(real_time_factor, str) and real_time_factor.strip().lower() == AUTO:
         return Pacer(rtf=min(max(1.0, min_rtf), max_rtf), auto=True, min_rtf=min_rtf, max_rtf=max_rtf,
-                     max_lag=max_lag)
+                     max_lag=max_lag, max_hold=max_hold)
     try:
         value = float(real_time_factor)
     except (TypeError, ValueError):
         raise PacingError('~real_time_factor must be a number >= 0 or "auto" (got %r)' % (real_time_factor,)) from None
     if not value >= 0 or math.isnan(value):
         raise PacingError('~real_time_factor must be a number >= 0 or "auto" (got %r)' % (real_time_factor,))
-    return Pacer(rtf=value if value > 0 else math.inf, auto=False, min_rtf=min_rtf, max_rtf=max_rtf, max_lag=max_lag)
+    return Pacer(rtf=value if value > 0 else math.inf, auto=False, min_rtf=min_rtf, max_rtf=max_rtf, max_lag=max_lag,
+                 max_hold=max_hold)
