@@ -20,6 +20,7 @@ collisions the robot drives into, memory growth of every node < 10% after the fi
 node deaths. Run inside the devel environment (make bench does that).
 """
 import json
+import math
 import os
 import re
 import signal
@@ -37,6 +38,7 @@ os.environ['ROS_MASTER_URI'] = 'http://localhost:%d' % PORT
 
 import rosgraph  # noqa: E402  (after ROS_MASTER_URI is set for this process)
 import rospy  # noqa: E402
+from geometry_msgs.msg import TransformStamped  # noqa: E402
 
 from mbot_slam_navigation.exploration_run import node_cpu_seconds, node_pids, stop  # noqa: E402
 from mbot_slam_navigation.explore_report import draw_curves  # noqa: E402
@@ -116,6 +118,12 @@ def main():
         rospy.init_node('bench_soak', disable_signals=True)
         contacts = []
         rospy.Subscriber('/gazebo/contacts', Contact, contacts.append)
+        # How far SLAM moved the robot's pose at once (loop closures): a jump larger than the
+        # costmaps' clearing reach leaves old marks on the robot.
+        corrections = []
+        rospy.Subscriber('/slam_gmapping/correction', TransformStamped,
+                         lambda m: corrections.append((m.header.stamp.to_sec(), math.hypot(
+                             m.transform.translation.x, m.transform.translation.y))))
         nav = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'random_navigation.py', '_max_goals:=%d' % GOALS,
                                 '_seed:=%d' % SEED], env=env, stdout=logs['random_navigation'], stderr=subprocess.STDOUT)
         samples = defaultdict(list)   # node -> [(sim s, MB)]
@@ -187,6 +195,9 @@ def main():
                                                  'points': {k: list(v) for k, v in summary[2].items()}},
         'contacts': dict(kinds), 'memory': growth, 'restarts': dict(restarts), 'not_running_at_end': sorted(gone),
         'answered_at_end': answered,
+        'slam_corrections': {'count': len(corrections), 'above_0.3_m': sum(1 for _, d in corrections if d > 0.3),
+                             'largest_m': round(max((d for _, d in corrections), default=0.0), 3),
+                             'largest_at_s': round(max(corrections, key=lambda c: c[1])[0], 1) if corrections else None},
         'cpu_s_per_simulated_s': {k: round(v / max(sim_end, 1e-9), 4) for k, v in cpu.items()},
     }
     tmp = os.path.join(out, 'report.json.tmp')
@@ -206,6 +217,9 @@ def main():
     else:
         print('  random_navigation printed no summary (see %s)' % logs['random_navigation'].name)
     print('  contacts: %s (targets: 0 world, 0 person (robot at fault))' % (dict(kinds) or 'none'))
+    sc = report['slam_corrections']
+    print('  slam_gmapping corrections of the map frame above 0.1 m: %d, %d above 0.3 m, largest %.2f m (at %s s)'
+          % (sc['count'], sc['above_0.3_m'], sc['largest_m'], sc['largest_at_s']))
     for name, g in sorted(growth.items()):
         print('  memory %-24s %6.1f MB at 10 min -> %6.1f MB at the end (%+.1f%%; max %.1f)'
               % (name, g['at_10_min_mb'], g['end_mb'], 100 * g['growth'], g['max_mb']))

@@ -684,6 +684,11 @@ class MoveBase {
     if (!clock_seen_.isZero() && now + ros::Duration(1.0) < clock_seen_) {
       clock_jump_s_ = (clock_seen_ - now).toSec();
       server_reset_pending_ = true;
+      // tf2_ros's listener clears its buffer only if a tf message arrives after it has seen the
+      // clock go back; one handled first is refused as old data and the newest transform stays
+      // hundreds of seconds ahead ("extrapolation ... only time 398.18 is in the buffer").
+      // Static transforms survive a clear.
+      tf_.clear();
     }
     clock_seen_ = now;
     if (!server_reset_pending_ || executing_) return;

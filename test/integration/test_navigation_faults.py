@@ -51,7 +51,9 @@ SILENCE = 5.0  # [s simulated] the laser's silence
 def random_navigation(*args):
     """`rosrun random_navigation.py ARGS` as a user runs it; yields (process, its output lines so
     far). On leaving, a script still running is stopped with SIGINT (as Ctrl-C) and its output read
-    to the end."""
+    to the end, and the private parameters that rosrun set (`_name:=value`) are deleted: they stay
+    on the parameter server, and the next run under the same name would take them (test 3 went to
+    test 2's visitor_spot)."""
     nav = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'random_navigation.py', '__name:=random_navigation']
                            + list(args), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     out = []
@@ -64,6 +66,10 @@ def random_navigation(*args):
             nav.send_signal(signal.SIGINT)
             nav.wait(timeout=30)
         reader.join(timeout=5)
+        try:
+            rospy.delete_param('/random_navigation')
+        except KeyError:
+            pass
 
 
 def node_pid(name):
@@ -214,7 +220,8 @@ class NavigationFaultsTest(unittest.TestCase):
 
     def test_3_move_base_killed_mid_goal_is_respawned_and_random_navigation_goes_on(self):
         with random_navigation('_max_goals:=3', '_seed:=2') as (nav, out):
-            self.assertTrue(wait_for(lambda: any('Going to' in l for l in out), 120.0), 'random_navigation sent no goal')
+            self.assertTrue(wait_for(lambda: any('Going to' in l for l in out), 120.0),
+                            'random_navigation sent no goal:\n' + ''.join(out)[-3000:])
             rospy.sleep(3.0)
             old = node_pid('/move_base')
             os.kill(old, signal.SIGKILL)
