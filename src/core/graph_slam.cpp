@@ -219,7 +219,6 @@ void GraphSlam::mergeLocked(int k) {
   n.parent = from;
   n.offset = relativePose(nodes_[from].pose, n.pose);
   ++stats_.merged_nodes;
-  (void)to;
 }
 
 void GraphSlam::rebuildLocalMapLocked() {

@@ -202,6 +202,7 @@ class SlamGmappingNode {
       scan_stamps_.clear();
       last_scan_tf_stamp_ = ros::Time();
       last_map_update_ = ros::Time();  // else no map until the clock passes the old update again
+      last_summary_ = ros::Time();
       first_transform_ = true;
     }
     last_stamp_ = msg->header.stamp;
