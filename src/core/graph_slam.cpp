@@ -413,11 +413,12 @@ void GraphSlam::optimize() {
   std::vector<Eigen::Vector3d> poses;
   std::vector<int> live;
   std::vector<PoseGraphEdge> edges, original;
+  std::vector<int> index_of;  // node index -> pose index (-1: merged)
   std::size_t n0;  // nodes at the snapshot
   {
     std::lock_guard<std::mutex> lock(mutex_);
     n0 = nodes_.size();
-    std::vector<int> index_of(n0, -1);
+    index_of.assign(n0, -1);
     for (std::size_t k = 0; k < n0; ++k) {
       if (nodes_[k].parent >= 0) continue;
       index_of[k] = static_cast<int>(live.size());
@@ -455,8 +456,6 @@ void GraphSlam::optimize() {
   bool moved = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<int> index_of(n0, -1);
-    for (std::size_t i = 0; i < live.size(); ++i) index_of[live[i]] = static_cast<int>(i);
     // Nodes added while optimizing move rigidly with the last optimized node (the newest nodes are
     // never merged); merged nodes move with their parent, which comes before them.
     const int last = live.back();

@@ -273,11 +273,8 @@ class SlamGmappingNode {
   // One line every kSummaryPeriod of (simulated) time: what the graph holds, so that a user who
   // leaves the robot running sees whether it keeps growing.
   void logSummary(const ros::Time& stamp) {
-    if (!last_summary_.isZero() && (stamp - last_summary_).toSec() < kSummaryPeriod) return;
-    if (last_summary_.isZero()) {
-      last_summary_ = stamp;
-      return;
-    }
+    if (last_summary_.isZero()) last_summary_ = stamp;
+    if ((stamp - last_summary_).toSec() < kSummaryPeriod) return;
     last_summary_ = stamp;
     const auto* graph = dynamic_cast<const mbot::core::GraphSlam*>(slam_.get());
     if (!graph) return;
