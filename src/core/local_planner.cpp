@@ -322,6 +322,7 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   for (int i = 0; i < steps; ++i) {
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
+    if (map.cost(cell) > max_centre_cost_) return;  // deeper into what the footprint touches (escaping)
     const int fp = footprintCostAt(map, {x, y, th}, may_defer ? &deferred : nullptr);
     if (fp < 0) return;
     occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
@@ -366,9 +367,45 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
 double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
                                      const Eigen::Vector3d& command) {
   if (path_grid_.values().size() != map.costs().size()) updateGrids(map, pose);
+  const Footprint full = useEscapeFootprint(map, pose);
   Trajectory t;
   generate(map, pose, velocity, command.x(), command.y(), command.z(), path_grid_.obstacle(), t);
+  restoreFootprint(full);
   return t.cost;
+}
+
+Footprint LocalPlanner::useEscapeFootprint(const Costmap& map, const Eigen::Vector3d& pose) {
+  // A footprint that already touches a lethal cell where the robot stands (a wall end the costmap's
+  // cells round onto its outline, a person who walked up to it, a turn the base drove wider than
+  // planned) makes every trajectory invalid, turning away included, and the robot would wait there
+  // for ever. It is then planned with the largest shrunken footprint that is free where it stands,
+  // and no step may bring its centre nearer to an obstacle than it is (a higher centre cost): moves
+  // out and along are allowed, deeper ones are not, and the full footprint returns once it is clear.
+  Footprint full = footprint_;
+  footprint_scale_ = 1.0;
+  full_radius_ = circumscribed_;
+  max_centre_cost_ = cost::kNoInformation;
+  if (footprintCost(map, pose, footprint_, true) < 0) {
+    for (double scale : kEscapeScales) {
+      Footprint shrunk(full.size());
+      for (std::size_t i = 0; i < full.size(); ++i) shrunk[i] = scale * full[i];
+      if (footprintCost(map, pose, shrunk, true) >= 0) {
+        footprint_ = std::move(shrunk);
+        circumscribed_ = scale * full_radius_;
+        footprint_scale_ = scale;
+        const Cell here = map.worldToCell(pose.head<2>());
+        if (map.contains(here)) max_centre_cost_ = map.cost(here);
+        break;
+      }
+    }
+  }
+  return full;
+}
+
+void LocalPlanner::restoreFootprint(const Footprint& full) {
+  footprint_ = full;
+  circumscribed_ = full_radius_;
+  max_centre_cost_ = cost::kNoInformation;
 }
 
 Trajectory LocalPlanner::simulate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
@@ -388,29 +425,9 @@ Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d&
   updateGrids(map, pose);
   if (shortcuts_) buildNonZeroTable(map);
   table_valid_ = shortcuts_;  // only for this call's map: scoreTrajectory may get another one
-  // A footprint that already touches a lethal cell where the robot stands (a wall end the costmap's
-  // cells round onto its outline, a person who walked up to it) makes every trajectory invalid,
-  // turning away included, and the robot would wait there for ever. This cycle is then planned with
-  // the largest shrunken footprint that is free where it stands: moves that go deeper in stay
-  // invalid, moves out are allowed, and the full footprint returns once it is clear.
-  const Footprint full = footprint_;
-  const double full_radius = circumscribed_;
-  footprint_scale_ = 1.0;
-  if (footprintCost(map, pose, footprint_, true) < 0) {
-    for (double scale : kEscapeScales) {
-      Footprint shrunk(full.size());
-      for (std::size_t i = 0; i < full.size(); ++i) shrunk[i] = scale * full[i];
-      if (footprintCost(map, pose, shrunk, true) >= 0) {
-        footprint_ = std::move(shrunk);
-        circumscribed_ = scale * full_radius;
-        footprint_scale_ = scale;
-        break;
-      }
-    }
-  }
+  const Footprint full = useEscapeFootprint(map, pose);
   Trajectory best = createTrajectories(map, pose, velocity);
-  footprint_ = full;
-  circumscribed_ = full_radius;
+  restoreFootprint(full);
   table_valid_ = false;
   if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;
   return best;

@@ -169,6 +169,46 @@ TEST(Footprint, RadiiPaddingAndCollision) {
   EXPECT_EQ(footprintCost(m, {0.1, 2.5, 0.0}, square), -1);  // partly off the map
 }
 
+TEST(Footprint, AnOutlineNearAWallCornerSeesTheCornerCell) {
+  // A wall ends in the lethal cell (42, 52) of a 5 cm grid. The footprint's edge from (2.17, 2.61)
+  // in cell (43, 52) to (2.11, 2.663) in cell (42, 53) crosses that cell near its corner, where
+  // Bresenham's walk between the two corner cells steps diagonally past it.
+  Costmap m(100, 100, 0.05, {0, 0});
+  m.setCost({42, 52}, cost::kLethal);
+  const Eigen::Vector3d pose(2.3, 2.75, 0.0);
+  const Footprint quad{{-0.13, -0.14}, {-0.19, -0.087}, {0.1, 0.15}, {0.15, -0.1}};
+  EXPECT_EQ(footprintCost(m, pose, quad), -1);
+  EXPECT_EQ(footprintCost(m, {2.3, 2.8, 0.0}, quad), 0);  // 5 cm further off: clear
+}
+
+TEST(Footprint, ARoundRobotCostsTheSameAtEveryHeading) {
+  // robot_radius 0.2, padded by 0.01: checked as the circle through its vertices, so that a robot
+  // that stands clear beside a wall corner can always turn on the spot (the 16-gon's outline cells
+  // change as it turns, and one of them may fall on the corner's cell).
+  Costmap m(100, 100, 0.05, {0, 0});
+  for (int x = 0; x <= 53; ++x) m.setCost({x, 52}, cost::kLethal);  // a wall ending at (2.7, 2.6..2.65)
+  const Footprint round = padFootprint(circleFootprint(0.2), 0.01);
+  const double r = circumscribedRadius(round);
+  int clear = 0;
+  for (double x = 2.6; x < 3.0; x += 0.013) {
+    for (double y = 2.25; y < 2.45; y += 0.011) {
+      const int first = footprintCost(m, {x, y, 0.0}, round);
+      for (int k = 1; k < 64; ++k) ASSERT_EQ(footprintCost(m, {x, y, k * M_PI / 32}, round), first) << x << " " << y;
+      // Clear exactly when no lethal cell comes within the circle's radius.
+      double nearest = 1e9;
+      for (int cx = 0; cx <= 53; ++cx) {
+        const double dx = std::max({cx * 0.05 - x, 0.0, x - (cx + 1) * 0.05});
+        const double dy = std::max({52 * 0.05 - y, 0.0, y - 53 * 0.05});
+        nearest = std::min(nearest, std::hypot(dx, dy));
+      }
+      EXPECT_EQ(first >= 0, nearest >= r) << x << " " << y << " nearest " << nearest;
+      clear += first >= 0;
+    }
+  }
+  EXPECT_GT(clear, 0);
+  EXPECT_LT(clear, 19 * 31);
+}
+
 #include "mbot_slam_navigation/core/obstacle_layer.h"
 
 namespace {

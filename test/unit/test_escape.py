@@ -45,6 +45,17 @@ def test_escape_stops_for_what_the_laser_sees_on_the_side_it_moves_to():
     assert cmd is not None and cmd[0] > 0, why
 
 
+def test_escape_does_not_turn_on_the_spot_beside_a_wall_corner():
+    # the kitchen door's jamb corner 0.205 m from the centre, behind-right: the wheels (0.211 m out)
+    # would sweep it; a target abeam needs a turn, so the escape says why instead of touching
+    corner = np.array([[-0.13, -0.158]])
+    cmd, why = escape_command((0.0, 0.0, 0.0), (0.0, 0.6), corner, 0.2, 0.1)
+    assert cmd is None and 'turning' in why
+    # 0.3 m off, it turns
+    cmd, why = escape_command((0.0, 0.0, 0.0), (0.0, 0.6), corner * 1.5, 0.2, 0.1)
+    assert cmd == (0.0, 0.5), why
+
+
 def test_motion_watch_counts_standing_still():
     w = MotionWatch(distance=0.2)
     w.update(0.0, (0.0, 0.0))

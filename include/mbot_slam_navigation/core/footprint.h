@@ -29,7 +29,9 @@ void validateFootprint(const Footprint& footprint);
 /// The highest cost under the footprint's outline at `pose` (x, y, yaw; costmap frame) as
 /// base_local_planner's CostmapModel checks it: -1 when any outline cell is lethal (254) or
 /// outside the map, else the maximum over the outline cells (unknown cells count as 255 only if
-/// `unknown_is_obstacle`, else are ignored).
+/// `unknown_is_obstacle`, else are ignored). The outline's cells are every cell it passes through.
+/// A round footprint (robot_radius's 16-gon: at least 8 vertices, all as far from the centre) is
+/// checked as the circle through its vertices, so that its cost does not change as it turns.
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint,
                   bool unknown_is_obstacle = false);
 

@@ -183,6 +183,12 @@ class LocalPlanner {
   bool table_valid_ = false, shortcuts_ = true;
   double circumscribed_ = 0.0;
   double footprint_scale_ = 1.0;
+  double full_radius_ = 0.0;                 // circumscribed_ of the whole footprint while escaping
+  uint8_t max_centre_cost_ = cost::kNoInformation;  // escaping: no step's centre cell may cost more
+  /// Swaps in the escape footprint when the whole one touches a lethal cell at `pose` (see the
+  /// .cpp); returns the whole footprint for restoreFootprint.
+  Footprint useEscapeFootprint(const Costmap& map, const Eigen::Vector3d& pose);
+  void restoreFootprint(const Footprint& full);
   // ROS's oscillation suppression and escape state.
   bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
   bool rotating_left_ = false, rotating_right_ = false, strafe_left_ = false, strafe_right_ = false;

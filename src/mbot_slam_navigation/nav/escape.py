@@ -26,11 +26,13 @@ def escape_command(pose: Tuple[float, float, float], target: Tuple[float, float]
                    lookahead: float = 0.1, turn_in_place: float = 0.6) -> Tuple[Optional[Tuple[float, float]], str]:
     """((v [m/s], w [rad/s]), '') to drive for target, or (None, 'arrived') / (None, why blocked).
 
-    The robot is a disc of `radius` (the mbot): it turns in place, which never sweeps new space for a
-    disc, until forwards or backwards (whichever needs less turning) faces the target within
-    turn_in_place [rad], then drives, steering towards it. It is blocked when a laser point lies
-    within radius + clearance of where it would be after `lookahead` metres and nearer to that than
-    it is now: moving away from what is already close (the wall it was wedged against) is allowed."""
+    The robot is about a disc of `radius` (the mbot; its wheels stand out a few millimetres): it
+    turns in place until forwards or backwards (whichever needs less turning) faces the target within
+    turn_in_place [rad], then drives, steering towards it. Turning is blocked when a laser point lies
+    within radius + clearance of its centre (a wheel would sweep it). Driving is blocked when a laser
+    point lies within radius + clearance of where it would be after `lookahead` metres and nearer to
+    that than it is now: moving away from what is already close (the wall it was wedged against) is
+    allowed."""
     dx, dy = target[0] - pose[0], target[1] - pose[1]
     if math.hypot(dx, dy) < arrive:
         return None, 'arrived'
@@ -39,10 +41,12 @@ def escape_command(pose: Tuple[float, float, float], target: Tuple[float, float]
     direction = 1.0 if tx >= 0 else -1.0
     error = math.atan2(ty * direction, tx * direction)  # heading error of the travel direction
     w = max(-0.5, min(0.5, 1.5 * error))  # turns the travel direction (backwards too) towards it
+    pts = np.asarray(points, float).reshape(-1, 2)
     if abs(error) > turn_in_place:
+        if len(pts) and np.any(np.hypot(pts[:, 0], pts[:, 1]) < radius + clearance):
+            return None, 'the laser sees an obstacle beside the robot: turning on the spot would touch it'
         return (0.0, 0.5 if error > 0 else -0.5), ''
     v = direction * speed * max(0.3, math.cos(error))
-    pts = np.asarray(points, float).reshape(-1, 2)
     if len(pts):
         d_now = np.hypot(pts[:, 0], pts[:, 1])
         d_new = np.hypot(pts[:, 0] - direction * lookahead, pts[:, 1])
