@@ -37,9 +37,11 @@ test: build
 # run_exploration with one line giving the outcome; exits 0 only for outcome complete. RVIZ=1 also
 # opens rviz.
 RVIZ ?= 0
+# ROBOTS=2 (up to 4): a team explores together (launch/multi_explore.launch), one report for all.
 demo: build
-	cd $(WS) && $(SOURCE) && rosrun $(PKG) run_exploration $(PKG) explore.launch report_dir:=$(CURDIR)/report \
-	  real_time_factor:=auto max_duration:=1200 rviz:=$(if $(filter 1 true,$(RVIZ)),true,false)
+	cd $(WS) && $(SOURCE) && rosrun $(PKG) run_exploration $(PKG) \
+	  $(if $(filter-out 1,$(or $(ROBOTS),1)),multi_explore.launch robots:=$(ROBOTS),explore.launch) \
+	  report_dir:=$(CURDIR)/report real_time_factor:=auto max_duration:=1200 rviz:=$(if $(filter 1 true,$(RVIZ)),true,false)
 
 bench: build
 	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/bench/run_all.py

@@ -72,9 +72,8 @@ def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robo
     }
 
 
-def draw_map(m: Grid, path: Sequence[Tuple[float, float]], goals: Sequence[Tuple[float, float, bool]],
-             filename: str) -> None:
-    """The map with the driven path (red) and the goals sent (green reached, orange not)."""
+def _map_canvas(m: Grid):
+    """(BGR picture of the map about 900 px across, world (x, y) -> pixel, line width)."""
     img = cv2.cvtColor(occupancy_to_image(m.data.astype(np.int16)), cv2.COLOR_GRAY2BGR)
     scale = max(1, 900 // max(img.shape[:2]))
     img = cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_NEAREST)
@@ -83,11 +82,35 @@ def draw_map(m: Grid, path: Sequence[Tuple[float, float]], goals: Sequence[Tuple
     def px(x, y):
         return (int((x - m.origin[0]) / m.resolution * scale), int((h - (y - m.origin[1]) / m.resolution) * scale))
 
+    return img, px, max(1, scale // 2)
+
+
+def draw_map(m: Grid, path: Sequence[Tuple[float, float]], goals: Sequence[Tuple[float, float, bool]],
+             filename: str) -> None:
+    """The map with the driven path (red) and the goals sent (green reached, orange not)."""
+    img, px, width = _map_canvas(m)
     if len(path) > 1:
-        cv2.polylines(img, [np.array([px(x, y) for x, y in path], np.int32)], False, (0, 0, 220), max(1, scale // 2))
+        cv2.polylines(img, [np.array([px(x, y) for x, y in path], np.int32)], False, (0, 0, 220), width)
     for x, y, ok in goals:
-        cv2.circle(img, px(x, y), 2 * scale, (0, 170, 0) if ok else (0, 140, 255), -1)
+        cv2.circle(img, px(x, y), 4 * width, (0, 170, 0) if ok else (0, 140, 255), -1)
     cv2.imwrite(filename, img)
+
+
+def draw_team_map(m: Grid, paths: Dict[str, Sequence[Tuple[float, float]]], filename: str) -> None:
+    """The merged map with each robot's path in its own colour (COLOURS, in name order), a legend,
+    and each start marked; written atomically."""
+    img, px, width = _map_canvas(m)
+    for k, name in enumerate(sorted(paths)):
+        colour, path = COLOURS[k % len(COLOURS)], paths[name]
+        if len(path) > 1:
+            cv2.polylines(img, [np.array([px(x, y) for x, y in path], np.int32)], False, colour, width)
+        if path:
+            cv2.circle(img, px(*path[0]), 5 * width, colour, 2)
+        cv2.putText(img, name, (10, 25 + 22 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.7, colour, 2)
+    root, ext = os.path.splitext(filename)
+    tmp = root + '.tmp' + ext
+    cv2.imwrite(tmp, img)
+    os.replace(tmp, filename)
 
 
 COLOURS = [(200, 80, 0), (0, 0, 220), (0, 150, 0), (180, 0, 180), (0, 140, 255), (120, 120, 0), (80, 80, 80)]
@@ -162,3 +185,51 @@ def write_figures(report_dir: str, figures: Dict) -> None:
     with open(tmp, 'w') as f:
         json.dump(figures, f, indent=2)
     os.replace(tmp, os.path.join(report_dir, 'report.json'))
+
+
+def team_figures(reports: Dict[str, Dict]) -> Dict:
+    """The team's figures from each robot's explorer report (by robot name): outcome `complete` only
+    if every robot's is, else the first of stuck, timeout, not_started found; the exploration time is
+    the last robot's; distances, goals and collisions per robot and summed."""
+    outcomes = [r.get('outcome', 'not_started') for r in reports.values()]
+    outcome = 'complete' if outcomes and all(o == 'complete' for o in outcomes) else next(
+        (o for o in ('stuck', 'timeout', 'not_started') if o in outcomes), 'not_started')
+    per_robot = {name: {k: r.get(k) for k in ('outcome', 'exploration_time_s', 'distance_m', 'goals_sent',
+                                              'goals_failed', 'collisions')}
+                 for name, r in sorted(reports.items())}
+    total = lambda key: round(sum(float(r.get(key) or 0) for r in reports.values()), 2)  # noqa: E731
+    return {
+        'outcome': outcome,
+        'robots': len(reports),
+        'exploration_time_s': max((float(r.get('exploration_time_s') or 0) for r in reports.values()), default=0.0),
+        'total_time_s': max((float(r.get('total_time_s') or 0) for r in reports.values()), default=0.0),
+        'wall_time_s': max((float(r.get('wall_time_s') or 0) for r in reports.values()), default=0.0),
+        'distance_m': total('distance_m'),
+        'goals_sent': int(total('goals_sent')),
+        'goals_failed': int(total('goals_failed')),
+        'collisions': int(total('collisions')),
+        'per_robot': per_robot,
+        'given_up': [g for r in reports.values() for g in r.get('given_up', [])],
+    }
+
+
+def write_team_report(report_dir: str, m: Grid, paths: Dict[str, List[Tuple[float, float]]],
+                      curve: List[Tuple[float, float]], reports: Dict[str, Dict], world: Optional[World] = None,
+                      start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
+    """The team's report in report_dir: the merged map (map.pgm/map.yaml), map.png with each robot's
+    path in its own colour, area.png (the merged map's known area against time) and report.json
+    (team_figures, with the merged map scored against the world when given); returns the figures."""
+    os.makedirs(report_dir, exist_ok=True)
+    figures = team_figures(reports)
+    figures['explored_area_m2'] = round(known_area(m), 2)
+    if world is not None:
+        figures.update(ground_truth_figures(m, world, start, robot_radius))
+        if rooms:
+            truth, origin = rasterize(world, m.resolution)
+            figures['room_coverage'] = {k: round(v, 3) for k, v in
+                                        room_coverage(m, truth, origin, m.resolution, rooms=rooms).items()}
+    save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
+    draw_team_map(m, paths, os.path.join(report_dir, 'map.png'))
+    draw_area(curve, os.path.join(report_dir, 'area.png'))
+    write_figures(report_dir, figures)
+    return figures

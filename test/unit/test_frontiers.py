@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from mbot_slam_navigation import _core
-from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, frontier_groups,
-                                                rank_frontiers)
+from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, Teammate, frontier_groups,
+                                                rank_frontiers, share_out, yields_goal)
 
 RES = 0.05
 
@@ -280,3 +280,39 @@ def test_two_frontiers_pulling_the_robot_to_and_fro_end_after_max_goals_per_plac
         if given_up:
             break
     assert sent_a == 4 and 'sent 4 times' in given_up[0].why
+
+
+def _frontier_at(x, y, path_m, size_m=2.0, potential_scale=3.0):
+    return Frontier(np.array([[x, y]]), size_m, (x, y), path_m, potential_scale * path_m - size_m)
+
+
+def test_a_team_shares_the_frontiers_out():
+    near_mate = _frontier_at(5.0, 0.0, 5.0)        # 5 m away by path; the teammate stands 1 m from it
+    mine = _frontier_at(-3.0, 0.0, 3.0)            # 3 m away; the teammate is 9 m from it
+    claimed = _frontier_at(0.0, 6.0, 6.0, 10.0)    # the teammate's goal is 0.5 m from it
+    mate = Teammate('robot2', (6.0, 0.0), (0.0, 6.5))
+    alone, n = share_out([near_mate, claimed, mine], [])
+    assert n == 0 and [f.goal for f in alone] == [mine.goal, claimed.goal, near_mate.goal]  # by cost
+    ours, n = share_out(sorted([near_mate, claimed, mine], key=lambda f: f.cost), [mate])
+    assert n == 1                                   # the claimed one is left to robot2
+    assert [f.goal for f in ours] == [mine.goal, near_mate.goal]
+    # the frontier nearer to robot2 costs 3 x (5 m - 1 m) more
+    assert ours[1].cost == pytest.approx(near_mate.cost + 3.0 * 4.0)
+    # two robots heading for one place: the name that sorts first keeps it
+    assert yields_goal((0.2, 6.4), 'robot3', [mate])
+    assert not yields_goal((0.2, 6.4), 'robot1', [mate])
+    assert not yields_goal((3.0, 0.0), 'robot3', [mate])
+
+
+def test_the_team_report_is_complete_only_when_every_robot_is():
+    from mbot_slam_navigation.explore_report import team_figures
+    a = {'outcome': 'complete', 'exploration_time_s': 200.0, 'distance_m': 30.0, 'goals_sent': 10, 'collisions': 0}
+    b = {'outcome': 'complete', 'exploration_time_s': 240.5, 'distance_m': 25.5, 'goals_sent': 8, 'collisions': 1,
+         'given_up': [{'x': 1.0, 'y': 2.0, 'size_m': 0.8, 'why': 'unreachable'}]}
+    f = team_figures({'robot1': a, 'robot2': b})
+    assert f['outcome'] == 'complete' and f['robots'] == 2
+    assert f['exploration_time_s'] == 240.5 and f['distance_m'] == pytest.approx(55.5)
+    assert f['goals_sent'] == 18 and f['collisions'] == 1 and len(f['given_up']) == 1
+    assert f['per_robot']['robot2']['distance_m'] == 25.5
+    assert team_figures({'robot1': a, 'robot2': dict(b, outcome='timeout')})['outcome'] == 'timeout'
+    assert team_figures({'robot1': a, 'robot2': {'outcome': 'not_started'}})['outcome'] == 'not_started'

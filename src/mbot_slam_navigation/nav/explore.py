@@ -30,7 +30,16 @@ scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (
 escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals sent within 0.6 m
 of one place before its frontier is given up; with the blacklist, this bounds every run),
 startup_timeout (300 s of wall time for move_base, the map, the costmap and the robot pose; then
-the report says not_started and why).
+the report says not_started and why), model_name ('': the simulator's contacts of every robot count;
+a team sets each robot's own).
+
+A team (launch/multi_explore.launch): with team_topic set (e.g. /explore/team), each explorer says
+where its robot is and where it goes (mbot_slam_navigation/ExplorerState, every cycle, under
+robot_name, default its namespace) and hears the others: a frontier whose goal lies within
+claim_radius (2.0 m) of a teammate's goal is left to it, and one nearer to a teammate than to this
+robot costs more (frontiers.share_out); of two robots heading for one place the one whose name sorts
+first keeps it. A robot whose frontiers are all claimed waits; the team's exploration is complete
+for a robot when no frontier is left to anyone.
 """
 import math
 import os
@@ -53,11 +62,11 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from mbot_slam_navigation import explore_report
 from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
-from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
 from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, MotionWatch, Plateau,
-                                                rank_frontiers)
+                                                Teammate, rank_frontiers, share_out, yields_goal)
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
@@ -108,6 +117,10 @@ class Explore:
         self.escape_timeout = r.number('escape_timeout', 30.0, positive=True)
         scan_topic = r.string('scan_topic', 'scan')
         cmd_vel_topic = r.string('cmd_vel_topic', 'cmd_vel')
+        self.model_name = r.string('model_name', '')
+        team_topic = r.string('team_topic', '')
+        self.robot_name = r.string('robot_name', rospy.get_namespace().strip('/') or 'robot')
+        self.claim_radius = r.number('claim_radius', 2.0, minimum=0.0)
         r.report_unknown()
 
         self.map: Optional[Grid] = None
@@ -135,6 +148,34 @@ class Explore:
         self.done_pub = rospy.Publisher('explore/complete', Bool, queue_size=1, latch=True)
         self.done_pub.publish(Bool(False))
         self.move_base = SimpleActionClient('move_base', MoveBaseAction)
+        self.mates = {}  # name -> (ExplorerState, wall time received)
+        self.team_pub = None
+        if team_topic:
+            self.team_pub = rospy.Publisher(team_topic, ExplorerState, queue_size=10)
+            rospy.Subscriber(team_topic, ExplorerState, self.on_mate, queue_size=20)
+
+    def on_mate(self, msg: ExplorerState) -> None:
+        if msg.robot != self.robot_name:
+            self.mates[msg.robot] = msg
+
+    def teammates(self) -> List[Teammate]:
+        """The other explorers still exploring, as they last said within 10 s (simulated)."""
+        now = rospy.Time.now()
+        return [Teammate(m.robot, (m.position.x, m.position.y), (m.goal.x, m.goal.y) if m.has_goal else None)
+                for m in list(self.mates.values())
+                if not m.done and abs((now - m.header.stamp).to_sec()) < 10.0]
+
+    def tell_team(self, pose, done: bool = False) -> None:
+        if self.team_pub is None:
+            return
+        msg = ExplorerState(robot=self.robot_name, done=done)
+        msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self.global_frame
+        if pose is not None:
+            msg.position = Point(pose[0], pose[1], 0.0)
+        goal = self.state.goal
+        if goal is not None and not done:
+            msg.has_goal, msg.goal = True, Point(goal.goal[0], goal.goal[1], 0.0)
+        self.team_pub.publish(msg)
 
     def on_map(self, msg: OccupancyGrid) -> None:
         self.map = grid_of(msg)
@@ -151,6 +192,8 @@ class Explore:
     def on_contact(self, msg: Contact) -> None:
         if not msg.robot_at_fault:  # a person walked into the robot: the simulator logs it; not ours
             return
+        if self.model_name and msg.model_name != self.model_name:
+            return  # another robot of the team
         self.collisions += 1
         rospy.logwarn('explore: the robot touched %s at (%.2f, %.2f)',
                       'the world' if msg.other_kind in ('', 'world') else msg.other, msg.pose.x, msg.pose.y)
@@ -307,9 +350,20 @@ class Explore:
                                     avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
             frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
             self.given_up = given_up + unreachable
+            claimed = 0
+            if self.team_pub is not None:
+                mates = self.teammates()
+                if self.state.goal is not None and yields_goal(self.state.goal.goal, self.robot_name, mates,
+                                                               self.claim_radius):
+                    rospy.loginfo('explore: (%.2f, %.2f) is also a teammate\'s goal; leaving it to them'
+                                  % self.state.goal.goal)
+                    self.state.goal = None
+                    self.move_base.cancel_goal()
+                frontiers, claimed = share_out(frontiers, mates, self.claim_radius, self.potential_scale)
             self.publish_markers(frontiers)
             self.plateau.update(now, explore_report.known_area(m), bool(frontiers) or self.state.goal is not None)
             new = self.state.choose(now, frontiers, pose[:2])
+            self.tell_team(pose)
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
                 self.send(new.goal[0], new.goal[1], yaw)
@@ -318,8 +372,11 @@ class Explore:
             reachable_m2 = stats.get('reachable_m2', 0.0)
             if frontiers or self.state.goal is not None:
                 empty_cycles, boxed_since = 0, None
-            elif waiting:
-                rospy.loginfo_throttle(30.0, 'explore: %d frontier(s) blacklisted for now; waiting to retry them' % waiting)
+            elif waiting or claimed:
+                # Not done: frontiers wait out their blacklisting, or teammates are on their way to
+                # them (one may fail and leave its frontier to this robot).
+                rospy.loginfo_throttle(30.0, 'explore: %d frontier(s) blacklisted for now, %d left to teammates; '
+                                       'waiting' % (waiting, claimed))
             elif reachable_m2 < BOXED_IN_M2:
                 # Not done: the robot is boxed in on its costmap (an obstacle seen beside it, a stale
                 # costmap). Clearing the costmaps frees it if the obstacle is gone; if not within
@@ -494,6 +551,7 @@ class Explore:
         for g in figures['given_up']:
             print('  given up: (%.2f, %.2f), %.1f m: %s' % (g['x'], g['y'], g['size_m'], g['why']), flush=True)
         rospy.loginfo('explore: exploration ended (%s): %s', outcome, figures)
+        self.tell_team(self.robot_pose(), done=True)
         self.done_pub.publish(Bool(True))  # last, so that the report is on disk when it says so
 
 

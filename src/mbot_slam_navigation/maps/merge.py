@@ -1,0 +1,109 @@
+"""Merging several robots' occupancy grids into one (multirobot_map_merge's job), ROS-free.
+
+A robot's grid lies in its own map frame; `Pose2` (x [m], y [m], yaw [rad]) is that frame's pose in
+the merged (world) frame: the robot's initial pose when it is known, else estimated by matching the
+grids (estimate_pose). Grids are nav_msgs/OccupancyGrid data: rows along y, -1 unknown, 0..100, the
+grid's own origin (x, y) [m] in its map frame with yaw 0 (what slam_gmapping publishes).
+
+Merging takes, cell by cell, the highest value any robot knows (unknown loses, occupied wins), as
+multirobot_map_merge composes its grids: a wall one robot has seen is never erased by another that
+saw the same place from elsewhere. OpenCV does the warping (nearest cell) and the feature matching
+(ORB and a RANSAC fit of a rotation and translation, as multirobot_map_merge does).
+"""
+import math
+from typing import Optional, Sequence, Tuple
+
+import cv2
+import numpy as np
+
+from mbot_slam_navigation.nav.frontiers import Grid
+
+Pose2 = Tuple[float, float, float]
+
+
+def _corners(g: Grid, pose: Pose2) -> np.ndarray:
+    h, w = g.data.shape
+    pts = np.array([[g.origin[0], g.origin[1]], [g.origin[0] + w * g.resolution, g.origin[1]],
+                    [g.origin[0], g.origin[1] + h * g.resolution],
+                    [g.origin[0] + w * g.resolution, g.origin[1] + h * g.resolution]])
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return np.column_stack([pose[0] + c * pts[:, 0] - s * pts[:, 1], pose[1] + s * pts[:, 0] + c * pts[:, 1]])
+
+
+def merge(grids: Sequence[Tuple[Grid, Pose2]], resolution: Optional[float] = None) -> Grid:
+    """One grid in the merged frame covering every (grid, pose of its map frame) given; each cell the
+    highest value of the robots' cells whose centres fall in it (-1 where none knows it)."""
+    if not grids:
+        raise ValueError('merge: no grids')
+    res = resolution or min(g.resolution for g, _ in grids)
+    corners = np.vstack([_corners(g, p) for g, p in grids])
+    x0, y0 = math.floor(corners[:, 0].min() / res) * res, math.floor(corners[:, 1].min() / res) * res
+    w = int(math.ceil((corners[:, 0].max() - x0) / res - 1e-9))
+    h = int(math.ceil((corners[:, 1].max() - y0) / res - 1e-9))
+    out = np.full((h, w), -1, np.int16)
+    for g, pose in grids:
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        k = g.resolution / res
+        # source pixel (col, row) -> merged pixel: pixel centres at integer coordinates (OpenCV's)
+        cx = g.origin[0] + 0.5 * g.resolution
+        cy = g.origin[1] + 0.5 * g.resolution
+        bx = (pose[0] + c * cx - s * cy - x0) / res - 0.5
+        by = (pose[1] + s * cx + c * cy - y0) / res - 0.5
+        m = np.array([[c * k, -s * k, bx], [s * k, c * k, by]])
+        warped = cv2.warpAffine(g.data.astype(np.int16), m, (w, h), flags=cv2.INTER_NEAREST,
+                                borderMode=cv2.BORDER_CONSTANT, borderValue=-1)
+        np.maximum(out, warped, out=out)
+    return Grid(out.astype(np.int8), res, (x0, y0))
+
+
+UPSAMPLE = 2  # ORB finds too few corners on 5 cm walls one cell thick; at 2.5 cm, blurred, enough
+
+
+def _image(g: Grid) -> np.ndarray:
+    """8-bit picture of the grid for feature matching (walls black, free white, unknown grey),
+    upsampled and blurred."""
+    d = g.data.astype(np.int16)
+    img = np.full(d.shape, 128, np.uint8)
+    img[(d >= 0) & (d < 50)] = 255
+    img[d >= 65] = 0
+    img = cv2.resize(img, None, fx=UPSAMPLE, fy=UPSAMPLE, interpolation=cv2.INTER_NEAREST)
+    return cv2.GaussianBlur(img, (3, 3), 0)
+
+
+def estimate_pose(a: Grid, b: Grid, min_inliers: int = 20) -> Tuple[Optional[Pose2], str]:
+    """(pose of b's map frame in a's map frame, '') from the grids' overlap, or (None, why): too few
+    features, too few matches agreeing on one rotation and translation (fewer than min_inliers),
+    or a fit that scales (the grids do not show the same place)."""
+    if abs(a.resolution - b.resolution) > 1e-9:
+        return None, 'the grids have different resolutions (%.3f and %.3f m)' % (a.resolution, b.resolution)
+    orb = cv2.ORB_create(nfeatures=3000)
+    ka, da = orb.detectAndCompute(_image(a), None)
+    kb, db = orb.detectAndCompute(_image(b), None)
+    if da is None or db is None or len(ka) < min_inliers or len(kb) < min_inliers:
+        return None, 'too few features (%d and %d) to match' % (len(ka or ()), len(kb or ()))
+    # Lowe's ratio test: a match only where the best is clearly better than the second best
+    pairs = cv2.BFMatcher(cv2.NORM_HAMMING).knnMatch(db, da, k=2)
+    matches = [p[0] for p in pairs if len(p) == 2 and p[0].distance < 0.8 * p[1].distance]
+    if len(matches) < min_inliers:
+        return None, 'too few matching features (%d, at least %d needed)' % (len(matches), min_inliers)
+    # image pixel centre i + 0.5 covers grid cell i // UPSAMPLE, whose centre is at grid pixel i // UPSAMPLE
+    pb = (np.float32([kb[m.queryIdx].pt for m in matches]) + 0.5) / UPSAMPLE - 0.5
+    pa = (np.float32([ka[m.trainIdx].pt for m in matches]) + 0.5) / UPSAMPLE - 0.5
+    cv2.setRNGSeed(1)  # RANSAC: the same grids give the same answer
+    m, inliers = cv2.estimateAffinePartial2D(pb, pa, method=cv2.RANSAC, ransacReprojThreshold=1.0, maxIters=5000,
+                                             confidence=0.999)
+    n = int(inliers.sum()) if inliers is not None else 0
+    if m is None or n < min_inliers:
+        return None, 'the overlap is too small: %d features agree on one placement, at least %d needed' % (n, min_inliers)
+    scale = math.hypot(m[0, 0], m[1, 0])
+    if abs(scale - 1.0) > 0.05:
+        return None, 'the best fit scales the map by %.2f: the grids do not show the same place' % scale
+    yaw = math.atan2(m[1, 0], m[0, 0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    # pixel (col, row) centre of cell (col, row) is at origin + (col + 0.5, row + 0.5) * res
+    res = a.resolution
+    t = m[:, 2]
+    ox = a.origin[0] + res * (t[0] + 0.5 - (c * 0.5 - s * 0.5)) - (c * b.origin[0] - s * b.origin[1])
+    oy = a.origin[1] + res * (t[1] + 0.5 - (s * 0.5 + c * 0.5)) - (s * b.origin[0] + c * b.origin[1])
+    return (float(ox), float(oy), float(yaw)), ''
+

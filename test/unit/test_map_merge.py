@@ -1,0 +1,90 @@
+"""Merging robots' maps (maps/merge.py): placement by known initial poses, estimation by matching."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+from mbot_slam_navigation.maps.merge import estimate_pose, merge
+from mbot_slam_navigation.nav.frontiers import Grid
+from mbot_slam_navigation.sim.ground_truth import rasterize
+from mbot_slam_navigation.sim.sdf_world import load_world
+
+HOME = os.path.join(os.path.dirname(__file__), '..', '..', 'worlds', 'mbot_sim_gazebo_navigation.world')
+
+
+from mbot_slam_navigation.transforms import inverse2d as inverse
+
+
+@pytest.fixture(scope='module')
+def home():
+    truth, origin = rasterize(load_world(HOME), 0.05)
+    data = np.where(truth > 0, 100, 0).astype(np.int8)
+    return Grid(data, 0.05, origin)
+
+
+def window(g: Grid, x0, x1, y0, y1) -> Grid:
+    """The part of g between x0..x1, y0..y1 [m] that a robot has seen; the rest unknown."""
+    d = np.full(g.data.shape, -1, np.int8)
+    rows, cols = np.indices(g.data.shape)
+    x, y = g.centre_of(rows, cols)
+    seen = (x >= x0) & (x < x1) & (y >= y0) & (y < y1)
+    d[seen] = g.data[seen]
+    return Grid(d, g.resolution, g.origin)
+
+
+def robot_map(world_part: Grid, pose) -> Grid:
+    """world_part as a robot whose map frame sits at `pose` in the world would have it."""
+    return merge([(world_part, inverse(pose))])
+
+
+def test_known_poses_put_each_robot_map_where_it_belongs(home):
+    a_pose, b_pose = (0.0, 0.0, 0.0), (-3.0, 2.0, math.pi / 2)  # the second robot started facing north
+    a = robot_map(window(home, -6, 1, -6, 1), a_pose)
+    b = robot_map(window(home, -1, 5, -4, 4), b_pose)
+    m = merge([(a, a_pose), (b, b_pose)])
+    assert m.resolution == pytest.approx(0.05)
+    rows, cols = np.indices(m.data.shape)
+    x, y = m.centre_of(rows, cols)
+    tr, tc = home.cell_of(x, y)
+    inside = home.inside(tr, tc)
+    known = (m.data >= 0) & inside
+    # everything either robot saw, and it agrees with the world
+    assert np.count_nonzero(known) * 0.05 ** 2 > 0.9 * (7 * 7 + 6 * 8 - 2 * 5)
+    agree = m.data[known] == home.data[tr[known], tc[known]]
+    assert agree.mean() > 0.99
+    # a wall one robot sees is never erased by the other's free cells
+    walls = known & (home.data[np.clip(tr, 0, home.data.shape[0] - 1), np.clip(tc, 0, home.data.shape[1] - 1)] == 100)
+    assert (m.data[walls] == 100).mean() > 0.97
+    # outside both windows: unknown
+    far = (x > 5.5) & (y < -5.0)
+    assert (m.data[far & (m.data >= 0)].size == 0)
+
+
+def test_matching_estimates_the_second_robot_start_from_the_overlap(home):
+    b_pose = (-1.0, 1.5, math.radians(30))
+    a = window(home, -6, 2, -6, 1)                             # robot a's map frame is the world
+    b = robot_map(window(home, -2, 5, -4, 4), b_pose)
+    est, why = estimate_pose(a, b)
+    assert est is not None, why
+    assert math.hypot(est[0] - b_pose[0], est[1] - b_pose[1]) < 0.1
+    assert abs(math.degrees(est[2] - b_pose[2])) < 2.0
+    # merged by the estimate, the walls land on the world's walls
+    m = merge([(a, (0.0, 0.0, 0.0)), (b, est)])
+    rows, cols = np.nonzero(m.data == 100)
+    x, y = m.centre_of(rows, cols)
+    tr, tc = home.cell_of(x, y)
+    near = np.zeros(len(x), bool)
+    for dr in (-2, -1, 0, 1, 2):
+        for dc in (-2, -1, 0, 1, 2):
+            r, c = np.clip(tr + dr, 0, home.data.shape[0] - 1), np.clip(tc + dc, 0, home.data.shape[1] - 1)
+            near |= home.data[r, c] == 100
+    assert near.mean() > 0.99
+
+
+def test_matching_refuses_maps_that_do_not_overlap(home):
+    a = window(home, -6, -2, -6, -3)
+    b = robot_map(window(home, 1.5, 4.5, 1, 3.5), (0.5, 0.5, 1.0))
+    est, why = estimate_pose(a, b)
+    assert est is None
+    assert 'overlap' in why or 'features' in why or 'scales' in why
