@@ -36,9 +36,21 @@ def stop(proc: subprocess.Popen, grace_s: float = 30.0) -> int:
     return proc.wait()
 
 
+def _namespace_of(pid: str) -> str:
+    """'robot1/' for a node roslaunch started in namespace /robot1 (its ROS_NAMESPACE), else ''."""
+    try:
+        with open('/proc/%s/environ' % pid, 'rb') as f:
+            env = f.read().decode(errors='replace').split('\0')
+    except OSError:
+        return ''
+    ns = next((e.split('=', 1)[1] for e in env if e.startswith('ROS_NAMESPACE=')), '')
+    ns = ns.strip('/')
+    return ns + '/' if ns else ''
+
+
 def _launched(launch_pid: int):
     """(node name, pid, /proc stat fields) of each process that roslaunch `launch_pid` started and
-    named with __name:=."""
+    named with __name:=; the name has its namespace in front ('robot1/move_base') if it has one."""
     for entry in os.listdir('/proc'):
         if not entry.isdigit():
             continue
@@ -54,7 +66,7 @@ def _launched(launch_pid: int):
             continue
         name = next((a.split(':=', 1)[1] for a in args if a.startswith('__name:=')), None)
         if name:
-            yield name, int(entry), fields
+            yield _namespace_of(entry) + name, int(entry), fields
 
 
 def node_pids(launch_pid: int) -> Dict[str, int]:
@@ -77,6 +89,9 @@ def summary(r: dict, report_dir: str) -> str:
     if 'coverage_of_reachable_free' in r:
         line += ', %.1f%% of the reachable free space, walls %.1f%% within 0.1 m' % (
             100 * r['coverage_of_reachable_free'], 100 * r['walls_within_tolerance'])
+    if r.get('per_robot'):
+        line += ', %d robots (%s)' % (len(r['per_robot']), ', '.join(
+            '%s %s, %.0f m' % (name, v.get('outcome'), v.get('distance_m') or 0.0) for name, v in sorted(r['per_robot'].items())))
     line += ', %d collisions, %d given up; report in %s' % (r.get('collisions', 0), len(r.get('given_up', [])),
                                                              report_dir)
     return line
