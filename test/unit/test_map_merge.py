@@ -88,3 +88,21 @@ def test_matching_refuses_maps_that_do_not_overlap(home):
     est, why = estimate_pose(a, b)
     assert est is None
     assert 'overlap' in why or 'features' in why or 'scales' in why
+
+
+def test_a_teammate_seen_in_a_doorway_does_not_stay_as_a_wall():
+    from mbot_slam_navigation.maps.merge import clear_swept
+    d = np.zeros((60, 60), np.int8)
+    d[30, :] = 100                                   # a wall along y = 1.5 (cells of 0.05 m)
+    d[30, 20:38] = 0                                 # its door, x 1.0 .. 1.9
+    rr, cc = np.indices(d.shape)
+    ring = np.abs(np.hypot(rr - 30, cc - 29) - 4) < 0.7   # a robot of 0.2 m seen standing in the door
+    d[ring] = 100
+    d[50:, 50:] = -1
+    m = Grid(d, 0.05, (0.0, 0.0))
+    trail = [(1.45, 0.5), (1.45, 1.0), (1.48, 1.5), (1.45, 2.5)]   # where that robot drove
+    out = clear_swept(m, [trail], 0.25)
+    assert not (out.data[ring] == 100).any()         # the ghost is gone
+    assert (out.data[30, :19] == 100).all() and (out.data[30, 40:] == 100).all()  # the wall stays
+    assert (out.data[50:, 50:] == -1).all()          # unknown stays unknown
+    assert clear_swept(m, [trail], 0.0) is m

@@ -107,3 +107,27 @@ def estimate_pose(a: Grid, b: Grid, min_inliers: int = 20) -> Tuple[Optional[Pos
     oy = a.origin[1] + res * (t[1] + 0.5 - (s * 0.5 + c * 0.5)) - (s * b.origin[0] + c * b.origin[1])
     return (float(ox), float(oy), float(yaw)), ''
 
+
+
+def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius: float) -> Grid:
+    """m with its occupied cells (>= 65) within `radius` [m] of a robot's trail (world (x, y) points
+    in the order driven) made free: the robots' bodies stood there, so whatever a robot's laser saw
+    there was a teammate, not a wall (a SLAM map keeps a teammate it saw standing in a doorway as an
+    obstacle, which would close that door to the whole team). Unknown cells stay unknown."""
+    if radius <= 0 or not any(len(t) for t in trails):
+        return m
+    mask = np.zeros(m.data.shape, np.uint8)
+    r = max(1, int(round(radius / m.resolution)))
+    for trail in trails:
+        if not len(trail):
+            continue
+        pts = np.array([[(x - m.origin[0]) / m.resolution - 0.5, (y - m.origin[1]) / m.resolution - 0.5]
+                        for x, y in trail])
+        px = np.round(pts).astype(np.int32)
+        if len(px) > 1:
+            cv2.polylines(mask, [px], False, 1, thickness=2 * r + 1)
+        for p in px:
+            cv2.circle(mask, (int(p[0]), int(p[1])), r, 1, -1)
+    data = m.data.copy()
+    data[(mask > 0) & (data >= 65)] = 0
+    return Grid(data, m.resolution, m.origin)
