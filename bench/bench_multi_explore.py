@@ -8,9 +8,9 @@ what one robot's stack costs (CPU seconds per simulated second of its slam_gmapp
 explore) and the bandwidth of its topics (/robotN/robot/laser/scan, /robotN/map, /tf, /map), so a
 user can size a fleet. Reports are kept in bench/out/team_<world>_<n>_<k>/.
 
-Environment: BENCH_TEAM_WORLDS (home), BENCH_TEAM_RUNS (3), BENCH_TEAM_ROBOTS (2: the team sizes
-besides 1). Targets: home with 2 robots <= 0.6x one robot's time (median), coverage >= 97%, walls >=
-99% within 0.1 m, 0 collisions. Run inside the devel environment (make bench does that).
+Environment: BENCH_TEAM_WORLDS (home; or large), BENCH_TEAM_RUNS (3), BENCH_TEAM_ROBOTS (2: the team
+sizes besides 1). Targets: home with 2 robots <= 0.6x one robot's time (median), the large floor with
+3 robots <= 0.45x, coverage >= 97%, walls >= 99% within 0.1 m, 0 collisions. Run inside the devel environment (make bench does that).
 """
 import json
 import os
@@ -25,7 +25,9 @@ from mbot_slam_navigation.exploration_run import run
 HERE = os.path.dirname(os.path.abspath(__file__))
 PKG = os.path.abspath(os.path.join(HERE, '..'))
 PORT = 11397
-WORLDS = {'home': 'mbot_sim_gazebo_navigation.world'}
+# world: (file, spawn arguments of the team beyond multi_explore.launch's defaults, which suit the home)
+WORLDS = {'home': ('mbot_sim_gazebo_navigation.world', []),
+          'large': ('large.world', ['x2:=1.0', 'y2:=0.8', 'x3:=-1.0', 'y3:=-0.8', 'x4:=1.0', 'y4:=-0.8'])}
 BANDWIDTH = r'''
 import json, sys, time
 import rospy
@@ -67,13 +69,13 @@ def one_run(world, n, k, log_dir, measure=False):
     out = os.path.join(HERE, 'out', 'team_%s_%d_%d' % (world, n, k))
     shutil.rmtree(out, ignore_errors=True)
     env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % PORT)
-    launch = ['explore.launch'] if n == 1 else ['multi_explore.launch', 'robots:=%d' % n]
+    launch = ['explore.launch'] if n == 1 else ['multi_explore.launch', 'robots:=%d' % n] + WORLDS[world][1]
     traffic = {}
     thread = bandwidth(env, ['/robot1/robot/laser/scan', '/robot1/map', '/tf', '/map'], traffic) if measure else None
     with open(os.path.join(log_dir, 'team_%s_%d_%d.log' % (world, n, k)), 'w') as log:
         r = run(['-p', str(PORT), 'mbot_slam_navigation'] + launch +
-                ['world_name:=' + os.path.join(PKG, 'worlds', WORLDS[world]), 'report_dir:=' + out,
-                 'max_duration:=1500'], wall_timeout=3600.0, env=env, stdout=log)
+                ['world_name:=' + os.path.join(PKG, 'worlds', WORLDS[world][0]), 'report_dir:=' + out,
+                 'max_duration:=%d' % (1500 if world == 'home' else 4000)], wall_timeout=3600.0, env=env, stdout=log)
     if thread is not None:
         thread.join(timeout=120.0)
     if r is None:
@@ -120,7 +122,8 @@ def main():
             emit(world, n, 'exploration time (simulated), median', times, 's', '', '%.0f')
             if n > 1 and one:
                 emit(world, n, 'exploration time against one robot (medians)',
-                     [statistics.median(times) / statistics.median(one)], 'x', '<= 0.6' if n == 2 else '', '%.2f')
+                     [statistics.median(times) / statistics.median(one)], 'x',
+                     {('home', 2): '<= 0.6', ('large', 3): '<= 0.45'}.get((world, n), ''), '%.2f')
             emit(world, n, 'wall time', [r['wall_time_s'] for r in complete], 's', '', '%.0f')
             emit(world, n, 'reachable free space explored', [100 * r.get('coverage_of_reachable_free', 0)
                                                              for r in complete], '%', '>= 97', '%.1f')
