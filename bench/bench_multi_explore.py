@@ -22,6 +22,8 @@ import threading
 
 from mbot_slam_navigation.exploration_run import run
 
+from bench_explore import emit as emit_for  # bench/ is on sys.path when a script in it runs
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PKG = os.path.abspath(os.path.join(HERE, '..'))
 PORT = 11397
@@ -92,10 +94,8 @@ def one_run(world, n, k, log_dir, measure=False):
 
 
 def emit(world, n, metric, values, unit, target='', fmt='%.3g'):
-    note = 'runs: ' + ', '.join(fmt % v for v in values)
-    print(json.dumps({'benchmark': 'team %s %d robot(s)' % (world, n), 'metric': metric,
-                      'value': statistics.median(values) if values else float('nan'), 'unit': unit,
-                      'target': target, 'note': note}), flush=True)
+    """bench_explore's line, with the team size where it has the load."""
+    emit_for(world, 'team of %d' % n, metric, values, unit, target, fmt)
 
 
 def main():

@@ -157,13 +157,11 @@ def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 40
     draw_curves({'area': curve}, 'explored area [m^2] against simulated time [s]', filename, size)
 
 
-def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
-                 curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
-                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
-    """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
-    With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free."""
+def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World], start: Tuple[float, float],
+                 robot_radius: float, rooms) -> Dict:
+    """`figures` with the map's own (explored area; against the world when given: coverage, walls,
+    each room's share), after writing the map (map.pgm, map.yaml) into report_dir."""
     os.makedirs(report_dir, exist_ok=True)
-    figures = dict(figures)
     figures['explored_area_m2'] = round(known_area(m), 2)
     if world is not None:
         figures.update(ground_truth_figures(m, world, start, robot_radius))
@@ -172,6 +170,15 @@ def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goal
             figures['room_coverage'] = {k: round(v, 3) for k, v in
                                         room_coverage(m, truth, origin, m.resolution, rooms=rooms).items()}
     save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
+    return figures
+
+
+def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
+                 curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
+                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
+    """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
+    With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free."""
+    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms)
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)
@@ -219,16 +226,7 @@ def write_team_report(report_dir: str, m: Grid, paths: Dict[str, List[Tuple[floa
     """The team's report in report_dir: the merged map (map.pgm/map.yaml), map.png with each robot's
     path in its own colour, area.png (the merged map's known area against time) and report.json
     (team_figures, with the merged map scored against the world when given); returns the figures."""
-    os.makedirs(report_dir, exist_ok=True)
-    figures = team_figures(reports)
-    figures['explored_area_m2'] = round(known_area(m), 2)
-    if world is not None:
-        figures.update(ground_truth_figures(m, world, start, robot_radius))
-        if rooms:
-            truth, origin = rasterize(world, m.resolution)
-            figures['room_coverage'] = {k: round(v, 3) for k, v in
-                                        room_coverage(m, truth, origin, m.resolution, rooms=rooms).items()}
-    save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
+    figures = _map_figures(report_dir, m, team_figures(reports), world, start, robot_radius, rooms)
     draw_team_map(m, paths, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)

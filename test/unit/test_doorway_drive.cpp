@@ -16,8 +16,10 @@
 #include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/trajectory_controller.h"
+#include "tutorial_planner_params.h"
 
 using namespace mbot::core;
+using mbot::core::test_fixtures::tutorialParams;
 
 namespace {
 struct Box {
@@ -77,25 +79,6 @@ Costmap costmapOf(const std::vector<Box>& boxes, const Eigen::Vector2d& origin, 
   return m;
 }
 
-// config/base_local_planner_params.yaml (the exploration tutorial's) over ROS's defaults.
-LocalPlannerParams tutorialParams() {
-  LocalPlannerParams p;
-  p.max_vel_x = 0.3;
-  p.min_vel_x = 0.05;
-  p.min_in_place_vel_theta = 0.5;
-  p.escape_vel = -0.1;
-  p.max_vel_theta = 1.0;
-  p.min_vel_theta = -1.0;
-  p.acc_lim_theta = 3.2;
-  p.acc_lim_x = 2.5;
-  p.path_distance_bias = 0.8;
-  p.goal_distance_bias = 0.4;
-  p.holonomic_robot = false;
-  p.meter_scoring = true;
-  p.sim_period = 1.0 / 3.0;
-  return p;
-}
-
 struct Outcome {
   bool reached = false, touched = false;
   int cycles = 0, invalid_cycles = 0;
@@ -113,7 +96,9 @@ Outcome drive(const Eigen::Vector3d& start, const Eigen::Vector2d& goal, const E
   LocalPlannerRosParams ros;
   ros.xy_goal_tolerance = 0.1;
   ros.yaw_goal_tolerance = 0.1;
-  TrajectoryController controller(tutorialParams(), ros, footprint);
+  LocalPlannerParams params = tutorialParams();
+  params.sim_period = 1.0 / 3.0;  // the tutorial's controller_frequency 3 Hz
+  TrajectoryController controller(params, ros, footprint);
   const double goal_yaw = std::atan2(goal.y() - start.y(), goal.x() - start.x());
   controller.setPlan(plan.path, goal_yaw);
   // The simulator's drive: the mbot's wheels (urdf/xacro/mbot_base_gazebo.xacro) with their

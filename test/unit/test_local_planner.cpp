@@ -6,28 +6,14 @@
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/local_planner.h"
 #include "mbot_slam_navigation/core/pose2d.h"
+#include "tutorial_planner_params.h"
 
 using namespace mbot::core;
+using mbot::core::test_fixtures::tutorialParams;
 
 namespace {
 // The four-wheel car's footprint from the tutorial's costmap_common_params.yaml.
 Footprint square() { return {{-0.2, -0.2}, {-0.2, 0.2}, {0.2, 0.2}, {0.2, -0.2}}; }
-
-// The tutorial's base_local_planner_params.yaml where it differs from the defaults.
-LocalPlannerParams tutorialParams() {
-  LocalPlannerParams p;
-  p.max_vel_x = 0.3;
-  p.min_vel_x = 0.05;
-  p.min_in_place_vel_theta = 0.5;
-  p.escape_vel = -0.1;
-  p.max_vel_theta = 1.0;
-  p.min_vel_theta = -1.0;
-  p.path_distance_bias = 0.8;
-  p.goal_distance_bias = 0.4;
-  p.holonomic_robot = false;
-  p.meter_scoring = true;
-  return p;
-}
 
 std::vector<Eigen::Vector2d> straightPlan(Eigen::Vector2d from, Eigen::Vector2d to, double step = 0.05) {
   std::vector<Eigen::Vector2d> plan;
