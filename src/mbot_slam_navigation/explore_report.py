@@ -26,10 +26,11 @@ def known_area(m: Grid) -> float:
 
 
 def reachable_free_space(world: World, start: Tuple[float, float], robot_radius: float,
-                         resolution: float = 0.05) -> Tuple[np.ndarray, Tuple[float, float]]:
+                         resolution: float = 0.05, truth=None) -> Tuple[np.ndarray, Tuple[float, float]]:
     """(mask, origin) of the world's free cells that the robot can sweep: those within robot_radius
-    of a centre position reachable from `start` without touching any shape."""
-    truth, origin = rasterize(world, resolution)
+    of a centre position reachable from `start` without touching any shape. `truth`: the world's
+    rasterize() at this resolution, if the caller has it (it takes a second or two)."""
+    truth, origin = truth if truth is not None else rasterize(world, resolution)
     free = (truth == 0).astype(np.uint8)
     clearance = cv2.distanceTransform(free, cv2.DIST_L2, 5) * resolution
     centres = (clearance > robot_radius).astype(np.uint8)
@@ -44,8 +45,9 @@ def reachable_free_space(world: World, start: Tuple[float, float], robot_radius:
 
 
 def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robot_radius: float,
-                         wall_tolerance: float = 0.1) -> Dict[str, float]:
-    mask, origin = reachable_free_space(world, start, robot_radius, m.resolution)
+                         wall_tolerance: float = 0.1, truth=None) -> Dict[str, float]:
+    truth = truth if truth is not None else rasterize(world, m.resolution)
+    mask, origin = reachable_free_space(world, start, robot_radius, m.resolution, truth)
     rows, cols = np.nonzero(mask)
     x = origin[0] + (cols + 0.5) * m.resolution
     y = origin[1] + (rows + 0.5) * m.resolution
@@ -54,7 +56,7 @@ def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robo
     wx, wy = m.centre_of(orows, ocols)
     d = distance_to_surfaces(world, np.column_stack([wx, wy])) if len(wx) else np.zeros(0)
     # A wall cell whose centre lies inside a solid is on the wall, however far from its surface.
-    truth, torigin = rasterize(world, m.resolution)
+    truth, torigin = truth
     tr = np.floor((wy - torigin[1]) / m.resolution).astype(int)
     tc = np.floor((wx - torigin[0]) / m.resolution).astype(int)
     ok = (tr >= 0) & (tc >= 0) & (tr < truth.shape[0]) & (tc < truth.shape[1])
@@ -164,11 +166,11 @@ def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World]
     os.makedirs(report_dir, exist_ok=True)
     figures['explored_area_m2'] = round(known_area(m), 2)
     if world is not None:
-        figures.update(ground_truth_figures(m, world, start, robot_radius))
+        truth = rasterize(world, m.resolution)  # once: it is the slow part of the report
+        figures.update(ground_truth_figures(m, world, start, robot_radius, truth=truth))
         if rooms:
-            truth, origin = rasterize(world, m.resolution)
             figures['room_coverage'] = {k: round(v, 3) for k, v in
-                                        room_coverage(m, truth, origin, m.resolution, rooms=rooms).items()}
+                                        room_coverage(m, truth[0], truth[1], m.resolution, rooms=rooms).items()}
     save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
     return figures
 
