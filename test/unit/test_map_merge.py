@@ -106,3 +106,26 @@ def test_a_teammate_seen_in_a_doorway_does_not_stay_as_a_wall():
     assert (out.data[30, :19] == 100).all() and (out.data[30, 40:] == 100).all()  # the wall stays
     assert (out.data[50:, 50:] == -1).all()          # unknown stays unknown
     assert clear_swept(m, [trail], 0.0) is m
+
+
+def test_the_nearest_robot_places_a_wall_both_saw():
+    # robot a drove along y = 0.5 and sees the wall at y = 1.5; robot b, 5 m away, sees it 0.1 m off
+    # (cells of 0.05 m from y = -4: row 110 is y = 1.5)
+    a = np.zeros((160, 80), np.int8)
+    a[110, :] = 100
+    b = np.zeros((160, 80), np.int8)
+    b[112, :] = 100
+    ga, gb = Grid(a, 0.05, (0.0, -4.0)), Grid(b, 0.05, (0.0, -4.0))
+    at = (0.0, 0.0, 0.0)
+    thick = merge([(ga, at), (gb, at)])
+    assert (thick.data[110, :] == 100).all() and (thick.data[112, :] == 100).all()   # occupied wins: doubled
+    trail_a = [(0.2, 0.5), (3.8, 0.5)]
+    trail_b = [(0.2, -3.5), (3.8, -3.5)]
+    m = merge([(ga, at), (gb, at)], trails=[trail_a, trail_b])
+    assert (m.data[110, :] == 100).all()            # robot a's wall, where a saw it from nearby
+    assert (m.data[112, :] == 0).all()              # b's copy, 0.1 m off, is not kept
+    # a cell only b knows keeps b's value, however far b was
+    a2 = a.copy()
+    a2[:, 60:] = -1
+    m2 = merge([(Grid(a2, 0.05, (0.0, -4.0)), at), (gb, at)], trails=[trail_a, trail_b])
+    assert (m2.data[112, 60:] == 100).all() and (m2.data[110, :60] == 100).all()
