@@ -367,10 +367,12 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
 double LocalPlanner::scoreTrajectory(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
                                      const Eigen::Vector3d& command) {
   if (path_grid_.values().size() != map.costs().size()) updateGrids(map, pose);
+  const double scale = footprint_scale_;  // lastFootprintScale() stays findBestPath's
   const Footprint full = useEscapeFootprint(map, pose);
   Trajectory t;
   generate(map, pose, velocity, command.x(), command.y(), command.z(), path_grid_.obstacle(), t);
   restoreFootprint(full);
+  footprint_scale_ = scale;
   return t.cost;
 }
 
