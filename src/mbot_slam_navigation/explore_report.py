@@ -204,7 +204,7 @@ def team_figures(reports: Dict[str, Dict]) -> Dict:
     outcome = 'complete' if outcomes and all(o == 'complete' for o in outcomes) else next(
         (o for o in ('stuck', 'timeout', 'not_started') if o in outcomes), 'not_started')
     per_robot = {name: {k: r.get(k) for k in ('outcome', 'exploration_time_s', 'distance_m', 'goals_sent',
-                                              'goals_failed', 'collisions')}
+                                              'goals_failed', 'collisions', 'why') if k in r or k != 'why'}
                  for name, r in sorted(reports.items())}
     total = lambda key: round(sum(float(r.get(key) or 0) for r in reports.values()), 2)  # noqa: E731
     return {

@@ -558,7 +558,10 @@ class Explore:
 def main() -> None:
     rospy.init_node('explore')
     node = Explore()
-    node.run()
+    try:
+        node.run()
+    except rospy.ROSInterruptException:
+        return  # shut down mid-exploration (roslaunch ended): not a crash, no traceback
     if node.shutdown_when_done or rospy.is_shutdown():
         return
     rospy.spin()
