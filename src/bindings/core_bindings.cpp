@@ -574,20 +574,23 @@ PYBIND11_MODULE(_core, m) {
           "update_with_scan",
           [](Costmap& c, const Eigen::Vector3d& sensor_pose, double angle_min, double angle_increment, double range_min,
              double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,
-             double obstacle_range, double raytrace_range, bool marking, bool clearing, bool inf_is_valid) {
+             double obstacle_range, double raytrace_range, bool marking, bool clearing, bool inf_is_valid,
+             bool too_close_is_obstacle) {
             mbot::core::ObservationSourceParams p;
             p.obstacle_range = obstacle_range;
             p.raytrace_range = raytrace_range;
             p.marking = marking;
             p.clearing = clearing;
             p.inf_is_valid = inf_is_valid;
+            p.too_close_is_obstacle = too_close_is_obstacle;
             const LaserScan scan = toScan(angle_min, angle_increment, range_min, range_max, ranges);
             py::gil_scoped_release release;
             return mbot::core::updateWithScan(c, sensor_pose, scan, p);
           },
           py::arg("sensor_pose"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("range_min"),
           py::arg("range_max"), py::arg("ranges"), py::arg("obstacle_range"), py::arg("raytrace_range"),
-          py::arg("marking") = true, py::arg("clearing") = true, py::arg("inf_is_valid") = true)
+          py::arg("marking") = true, py::arg("clearing") = true, py::arg("inf_is_valid") = true,
+          py::arg("too_close_is_obstacle") = true)
       .def(
           "footprint_cost",
           [](const Costmap& c, const Eigen::Vector3d& pose, const std::vector<Eigen::Vector2d>& footprint,

@@ -111,7 +111,8 @@ void bindNavigation(py::module& m) {
       .def_readonly("min_obstacle_height", &ObservationSourceConfig::min_obstacle_height)
       .def_readonly("obstacle_range", &ObservationSourceConfig::obstacle_range)
       .def_readonly("raytrace_range", &ObservationSourceConfig::raytrace_range)
-      .def_readonly("inf_is_valid", &ObservationSourceConfig::inf_is_valid);
+      .def_readonly("inf_is_valid", &ObservationSourceConfig::inf_is_valid)
+      .def_readonly("too_close_is_obstacle", &ObservationSourceConfig::too_close_is_obstacle);
   py::class_<StaticLayerConfig>(m, "StaticLayerConfig")
       .def(py::init<>())
       .def_readwrite("name", &StaticLayerConfig::name)

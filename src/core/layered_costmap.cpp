@@ -64,6 +64,7 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
   s.obstacle_range = r.number("obstacle_range", layer.number("obstacle_range", 2.5, std::nullopt, true), std::nullopt, true);
   s.raytrace_range = r.number("raytrace_range", layer.number("raytrace_range", 3.0, std::nullopt, true), std::nullopt, true);
   s.inf_is_valid = r.boolean("inf_is_valid", true);
+  s.too_close_is_obstacle = r.boolean("too_close_is_obstacle", true);
   r.reportUnknown();
   return s;
 }
@@ -485,6 +486,7 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
       p.marking = src.marking;
       p.clearing = src.clearing;
       p.inf_is_valid = src.inf_is_valid;
+      p.too_close_is_obstacle = src.too_close_is_obstacle;
       for (const auto& obs : observations_[i]) {
         // Clearing and marking in one pass per scan, as ObstacleLayer does per cloud.
         updateWithScan(obstacle_, obs.pose, obs.scan, p);

@@ -323,6 +323,9 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
     if (map.cost(cell) > max_centre_cost_) return;  // deeper into what the footprint touches (escaping)
+    if (i > 0 && min_lethal_distance_ < std::numeric_limits<double>::infinity() &&
+        nearestLethal(map, {x, y}, min_lethal_distance_) < min_lethal_distance_ - 1e-3)
+      return;  // nearer to what stands inside the footprint (escaping)
     const int fp = footprintCostAt(map, {x, y, th}, may_defer ? &deferred : nullptr);
     if (fp < 0) return;
     occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
@@ -383,10 +386,21 @@ Footprint LocalPlanner::useEscapeFootprint(const Costmap& map, const Eigen::Vect
   // for ever. It is then planned with the largest shrunken footprint that is free where it stands,
   // and no step may bring its centre nearer to an obstacle than it is (a higher centre cost): moves
   // out and along are allowed, deeper ones are not, and the full footprint returns once it is clear.
+  // A lethal cell inside the footprint but off its outline (a person who walked into the robot,
+  // seen by the laser from inside or marked at range_min when it covers the laser) leaves the
+  // outline free: the footprint stays whole, and only the rule on the distance applies.
   Footprint full = footprint_;
   footprint_scale_ = 1.0;
   full_radius_ = circumscribed_;
   max_centre_cost_ = cost::kNoInformation;
+  min_lethal_distance_ = std::numeric_limits<double>::infinity();
+  const Cell here = map.worldToCell(pose.head<2>());
+  const double inscribed = inscribedRadius(full);
+  const double inside = nearestLethal(map, pose.head<2>(), inscribed);
+  if (inside < inscribed) {
+    min_lethal_distance_ = inside;
+    if (map.contains(here)) max_centre_cost_ = map.cost(here);
+  }
   if (footprintCost(map, pose, footprint_, true) < 0) {
     for (double scale : kEscapeScales) {
       Footprint shrunk(full.size());
@@ -395,8 +409,8 @@ Footprint LocalPlanner::useEscapeFootprint(const Costmap& map, const Eigen::Vect
         footprint_ = std::move(shrunk);
         circumscribed_ = scale * full_radius_;
         footprint_scale_ = scale;
-        const Cell here = map.worldToCell(pose.head<2>());
         if (map.contains(here)) max_centre_cost_ = map.cost(here);
+        min_lethal_distance_ = nearestLethal(map, pose.head<2>(), full_radius_);
         break;
       }
     }
@@ -408,6 +422,26 @@ void LocalPlanner::restoreFootprint(const Footprint& full) {
   footprint_ = full;
   circumscribed_ = full_radius_;
   max_centre_cost_ = cost::kNoInformation;
+  min_lethal_distance_ = std::numeric_limits<double>::infinity();
+}
+
+double LocalPlanner::nearestLethal(const Costmap& map, const Eigen::Vector2d& at, double within) const {
+  // The cells of the square around `at`, as squares (so the distance to a straight wall does not
+  // change along it): a few dozen at these radii, and only while escaping.
+  const double res = map.resolution(), half = 0.5 * res;
+  const int reach = static_cast<int>(std::ceil(within / res)) + 1;
+  const Cell c0 = map.worldToCell(at);
+  double best = std::numeric_limits<double>::infinity();
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const Cell c{c0.x + dx, c0.y + dy};
+      if (!map.contains(c) || map.cost(c) != cost::kLethal) continue;
+      const Eigen::Vector2d off = (map.cellCenter(c) - at).cwiseAbs().array() - half;
+      const double d = off.cwiseMax(0.0).norm();
+      if (d <= within && d < best) best = d;
+    }
+  }
+  return best;
 }
 
 Trajectory LocalPlanner::simulate(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity,
@@ -428,6 +462,8 @@ Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d&
   if (shortcuts_) buildNonZeroTable(map);
   table_valid_ = shortcuts_;  // only for this call's map: scoreTrajectory may get another one
   const Footprint full = useEscapeFootprint(map, pose);
+  inside_distance_ = min_lethal_distance_ < inscribedRadius(full) ? min_lethal_distance_
+                                                                   : std::numeric_limits<double>::infinity();
   Trajectory best = createTrajectories(map, pose, velocity);
   restoreFootprint(full);
   table_valid_ = false;

@@ -23,7 +23,16 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     double r = scan.ranges_m[i];
     bool is_return = true;
-    if (std::isnan(r) || r < scan.range_min_m) continue;  // NaN, -inf, too close: nothing known
+    if (std::isinf(r) && r < 0.0) {
+      // REP 117: something nearer than range_min. Nothing to clear; its place is known to within
+      // range_min, so it is marked there (inside the footprint: the robot must not drive into it).
+      if (!params.too_close_is_obstacle || !params.marking) continue;
+      const double a = sensor_pose.z() + scan.beamAngle(i);
+      const Cell end = layer.worldToCell(origin + scan.range_min_m * Eigen::Vector2d(std::cos(a), std::sin(a)));
+      if (layer.contains(end)) marks.push_back(end);
+      continue;
+    }
+    if (std::isnan(r) || r < scan.range_min_m) continue;  // NaN, or a driver's finite error code: nothing known
     if (std::isinf(r) || r >= scan.range_max_m) {
       if (!params.inf_is_valid) continue;
       r = std::min(params.raytrace_range, scan.range_max_m);

@@ -211,6 +211,7 @@ ControlResult TrajectoryController::compute(const Costmap& costmap, const Eigen:
   rotating_to_goal_ = false;
   const Trajectory best = planner_.findBestPath(costmap, pose, vel);
   out.footprint_scale = planner_.lastFootprintScale();
+  out.obstacle_inside_m = planner_.lastObstacleInside();
   last_trajectory_ = best.points;
   if (best.cost < 0) {
     out.why = "no valid trajectory (every sampled command collides or leaves the plan)";

@@ -474,6 +474,10 @@ class MoveBase {
         ROS_WARN_THROTTLE(5, "move_base: the robot's footprint touches an obstacle in the local costmap where it stands; "
                              "moving out with the footprint shrunk to %.0f%%", 100.0 * control.footprint_scale);
       }
+      if (std::isfinite(control.obstacle_inside_m)) {
+        ROS_WARN_THROTTLE(5, "move_base: an obstacle stands inside the robot's footprint, %.2f m from its centre (a person "
+                             "who walked into it?); only moves that keep away from it", control.obstacle_inside_m);
+      }
       if (controller_->reached()) {
         stop();
         controller_->reset();

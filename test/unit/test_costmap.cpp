@@ -251,3 +251,23 @@ TEST(ObstacleLayer, ClearingStopsAtRaytraceRange) {
   EXPECT_EQ(layer.cost(layer.worldToCell({1.2, 0.0})), cost::kLethal);  // beyond raytrace_range: kept
   EXPECT_EQ(layer.cost(layer.worldToCell({4.0, 0.0})), cost::kLethal);  // not marked anew, not cleared
 }
+
+TEST(ObstacleLayer, MinusInfinityMarksRangeMinAndDriverErrorCodesDoNothing) {
+  // A person covers the laser: REP 117's -inf (nearer than range_min). It is marked at range_min
+  // along the beam, so the costmap has it where the robot is; a finite reading below range_min (a
+  // driver's error code) marks nothing; a later return beyond it clears the mark.
+  Costmap layer(100, 100, 0.05, {-2.5, -2.5}, cost::kNoInformation);
+  ObservationSourceParams p;
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(updateWithScan(layer, {0, 0, 0}, fan({-inf, 0.02f, std::nanf(""), -inf}), p), 2);
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.1, 0.0})), cost::kLethal);    // east, -inf
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.0, -0.1})), cost::kLethal);   // south, -inf
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.0, 0.1})), cost::kNoInformation);  // north, 0.02 m: nothing
+  updateWithScan(layer, {0, 0, 0}, fan({1.0f, inf, inf, inf}), p);
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.1, 0.0})), cost::kFree);      // the person left
+  EXPECT_EQ(layer.cost(layer.worldToCell({0.0, -0.1})), cost::kFree);
+  // costmap_2d's way, on request: -inf is dropped.
+  Costmap ros_way(100, 100, 0.05, {-2.5, -2.5}, cost::kNoInformation);
+  p.too_close_is_obstacle = false;
+  EXPECT_EQ(updateWithScan(ros_way, {0, 0, 0}, fan({-inf, -inf, -inf, -inf}), p), 0);
+}

@@ -5,6 +5,7 @@
 
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/local_planner.h"
+#include "mbot_slam_navigation/core/obstacle_layer.h"
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "tutorial_planner_params.h"
 
@@ -212,6 +213,53 @@ TEST(LocalPlanner, AFootprintAlreadyTouchingAWallMovesOutAndNeverDeeper) {
   // The same robot clear of the wall plans with its whole footprint.
   lp.findBestPath(m, {2.5, 2.5, M_PI}, {0, 0, 0});
   EXPECT_EQ(lp.lastFootprintScale(), 1.0);
+}
+
+TEST(LocalPlanner, APersonInsideTheFootprintIsNeverDrivenNearer) {
+  // A person walked into the robot: lethal cells 0.12 m ahead of its centre, inside its 0.2 m
+  // footprint, where every cell around costs the same (inscribed), so the centre cost cannot tell
+  // nearer from farther. The plan runs on through the person: the robot must not follow it there,
+  // but may back away or turn.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int dy = -1; dy <= 1; ++dy) raw.setCost(raw.worldToCell({2.62, 2.5 + 0.05 * dy}), cost::kLethal);
+  const Costmap m = inflated(raw);
+  const Footprint round = circleFootprint(0.2);
+  const Eigen::Vector3d pose(2.5, 2.5, 0.0);
+  ASSERT_GE(footprintCost(m, pose, round), 0);  // the outline does not see it: it is inside
+  LocalPlanner lp(tutorialParams(), round);
+  lp.setPlan(straightPlan({2.5, 2.5}, {4.5, 2.5}));  // on east, through the person
+  const Trajectory t = lp.findBestPath(m, pose, {0, 0, 0});
+  EXPECT_NEAR(lp.lastObstacleInside(), 0.10, 1e-6);  // the near side of the cell at 2.60 .. 2.65
+  if (t.cost >= 0.0) {
+    for (const Eigen::Vector3d& q : t.points) {
+      EXPECT_LE(q.x(), pose.x() + 1e-3) << "drove on into the person";
+    }
+  }
+  // Scored one by one: forward is invalid, backing away is not.
+  EXPECT_LT(lp.scoreTrajectory(m, pose, {0, 0, 0}, {0.3, 0.0, 0.0}), 0.0);
+  EXPECT_LT(lp.scoreTrajectory(m, pose, {0, 0, 0}, {0.2, 0.0, 0.5}), 0.0);
+  EXPECT_GE(lp.scoreTrajectory(m, pose, {0, 0, 0}, {0.0, 0.0, 1.0}), 0.0);  // turning keeps its distance
+}
+
+TEST(LocalPlanner, ALaserCoveredAllRoundStopsTheRobot) {
+  // Every beam -inf (a person stands over the laser): marks at range_min all round. No shrunken
+  // footprint is free, so no command: the robot waits until the person has gone.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  ObservationSourceParams p;
+  LaserScan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = 2 * M_PI / 360;
+  s.range_min_m = 0.1;
+  s.range_max_m = 5.0;
+  s.ranges_m.assign(360, -std::numeric_limits<float>::infinity());
+  updateWithScan(raw, {2.5, 2.5, 0.0}, s, p);
+  const Costmap m = inflated(raw);
+  LocalPlanner lp(tutorialParams(), circleFootprint(0.2));
+  lp.setPlan(straightPlan({2.5, 2.5}, {4.5, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {2.5, 2.5, 0.0}, {0, 0, 0});
+  EXPECT_LT(t.cost, 0.0);
+  EXPECT_EQ(t.xv, 0.0);
+  EXPECT_EQ(t.thetav, 0.0);
 }
 
 TEST(LocalPlanner, BoxedInGivesNoCommand) {

@@ -52,6 +52,7 @@ struct ObservationSourceConfig {
   double max_obstacle_height = 2.0, min_obstacle_height = 0.0;       ///< [m]
   double obstacle_range = 2.5, raytrace_range = 3.0;                 ///< [m]
   bool inf_is_valid = true;  ///< ROS's default is false (then +inf clears nothing); see the README
+  bool too_close_is_obstacle = true;  ///< ours: -inf marks range_min (costmap_2d ignores it)
 };
 
 struct ObstacleLayerConfig {

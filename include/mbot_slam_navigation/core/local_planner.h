@@ -116,6 +116,10 @@ class LocalPlanner {
   /// lethal cell where the robot stood and a shrunken one let it move out (kEscapeScales).
   double lastFootprintScale() const { return footprint_scale_; }
   static constexpr double kEscapeScales[] = {0.9, 0.8, 0.7, 0.6, 0.5};
+  /// [m] The distance from the robot's centre to the nearest lethal cell inside its footprint (its
+  /// inscribed circle) at the last findBestPath; infinity when none. While there is one, no step of
+  /// a trajectory may come nearer to it (see useEscapeFootprint).
+  double lastObstacleInside() const { return inside_distance_; }
 
   /// The global plan (costmap frame, pruned to start near the robot).
   void setPlan(const std::vector<Eigen::Vector2d>& plan);
@@ -185,6 +189,13 @@ class LocalPlanner {
   double footprint_scale_ = 1.0;
   double full_radius_ = 0.0;                 // circumscribed_ of the whole footprint while escaping
   uint8_t max_centre_cost_ = cost::kNoInformation;  // escaping: no step's centre cell may cost more
+  // Escaping: the distance [m] from the centre to the nearest lethal cell within the whole
+  // footprint's circumscribed radius where the robot stands (infinity: none); no step may bring
+  // one nearer. Inside the inscribed radius every cell costs the same, so the centre cost alone
+  // lets the robot drive on into a person who stands inside its footprint.
+  double min_lethal_distance_ = std::numeric_limits<double>::infinity();
+  double inside_distance_ = std::numeric_limits<double>::infinity();
+  double nearestLethal(const Costmap& map, const Eigen::Vector2d& at, double within) const;
   /// Swaps in the escape footprint when the whole one touches a lethal cell at `pose` (see the
   /// .cpp); returns the whole footprint for restoreFootprint.
   Footprint useEscapeFootprint(const Costmap& map, const Eigen::Vector3d& pose);

@@ -5,7 +5,11 @@
 //   - clearing: every beam clears up to its end (exclusive) or raytrace_range, whichever is nearer;
 //     +inf (no return within range_max) clears to min(raytrace_range, range_max) when
 //     inf_is_valid, as costmap_2d does for `inf_is_valid: true`;
-//   - NaN, -inf and returns below range_min do nothing.
+//   - -inf (REP 117: an object nearer than range_min) marks the cell at range_min along its beam
+//     when too_close_is_obstacle (ours; costmap_2d drops it): a person who walks into the robot
+//     and covers its laser is then in the costmap, where the robot is, and it does not drive on
+//     into them on the strength of marks from before;
+//   - NaN, finite returns below range_min (drivers' error codes) and -inf otherwise do nothing.
 // Frames: `sensor_pose` is the laser in the costmap's global frame (x [m], y [m], yaw [rad]).
 #pragma once
 
@@ -23,6 +27,7 @@ struct ObservationSourceParams {
   bool marking = true;
   bool clearing = true;
   bool inf_is_valid = true;      ///< +inf clears (a simulated or real laser that reports "nothing")
+  bool too_close_is_obstacle = true;  ///< -inf marks range_min (costmap_2d: ignored)
   void validate() const;         ///< std::invalid_argument naming the parameter
 };
 

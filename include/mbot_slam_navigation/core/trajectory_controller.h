@@ -7,6 +7,7 @@
 // in the local costmap's frame, velocities (vx, vy, vtheta) in the robot's.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,7 @@ struct ControlResult {
   Eigen::Vector3d command = Eigen::Vector3d::Zero();  ///< (vx, vy, vtheta)
   std::string why;                                    ///< why not, when !valid
   double footprint_scale = 1.0;                       ///< < 1: moving out of an obstacle the footprint touched
+  double obstacle_inside_m = std::numeric_limits<double>::infinity();  ///< [m] LocalPlanner::lastObstacleInside
 };
 
 class TrajectoryController {
