@@ -113,7 +113,7 @@ PYBIND11_MODULE(_core, m) {
       .def(py::init<const AmclParams&, unsigned>(), py::arg("params"), py::arg("seed"))
       .def("set_map", &Amcl::setMap)
       .def("has_map", &Amcl::hasMap)
-      .def("init_gaussian", &Amcl::initGaussian, py::arg("mean"), py::arg("cov"))
+      .def("init_gaussian", &Amcl::initGaussian, py::arg("mean"), py::arg("cov"), py::arg("free_only") = false)
       .def("init_uniform", &Amcl::initUniform)
       .def("motion_update", &Amcl::motionUpdate, py::arg("odom_old"), py::arg("odom_new"),
            py::call_guard<py::gil_scoped_release>())

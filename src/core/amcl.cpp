@@ -157,7 +157,7 @@ void Amcl::setMap(std::shared_ptr<const AmclMap> map) {
   field_map_ = nullptr;
 }
 
-void Amcl::initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov) {
+void Amcl::initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov, bool free_only) {
   // Sample through the Cholesky factor, so correlated x-y covariances (rviz never sends them, a
   // saved pose may) are honoured. A non-positive-definite matrix falls back to its diagonal.
   Eigen::Matrix3d l = Eigen::Matrix3d::Zero();
@@ -169,9 +169,17 @@ void Amcl::initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov)
   }
   std::normal_distribution<double> n01(0.0, 1.0);
   particles_.assign(params_.max_particles, AmclParticle{mean, 1.0 / params_.max_particles});
+  const bool check = free_only && map_ && !map_->freeCells().empty();
+  const double res = map_ ? map_->resolution() : 1.0;
   for (auto& p : particles_) {
-    const Eigen::Vector3d z(n01(rng_), n01(rng_), n01(rng_));
-    p.pose = mean + l * z;
+    for (int tries = 0; tries < 50; ++tries) {
+      const Eigen::Vector3d z(n01(rng_), n01(rng_), n01(rng_));
+      p.pose = mean + l * z;
+      if (!check) break;
+      const int cx = static_cast<int>(std::floor((p.pose.x() - map_->origin().x()) / res));
+      const int cy = static_cast<int>(std::floor((p.pose.y() - map_->origin().y()) / res));
+      if (map_->state(cx, cy) == -1) break;
+    }
     p.pose.z() = normalizeAngle(p.pose.z());
   }
   w_slow_ = w_fast_ = 0.0;

@@ -183,6 +183,33 @@ TEST(Amcl, LaserModelsPreferTheTruePose) {
   }
 }
 
+TEST(Amcl, AWideSearchPutsItsParticlesOnlyInFreeCells) {
+  // The recovery's search after a carry: a 1.5 m normal around the last estimate. Drawn as it is,
+  // a share of the particles lands in walls and outside the room, where the robot cannot be;
+  // free_only draws them again.
+  const auto map = roomMap();
+  AmclParams p;
+  p.max_particles = 3000;
+  Amcl a(p, 7);
+  a.setMap(map);
+  const Eigen::Vector3d near_wall(0.2, 0.2, 0.0);  // 1.2 m from the room's corner
+  const Eigen::Matrix3d cov = Eigen::Vector3d(2.25, 2.25, M_PI * M_PI).asDiagonal();
+  auto outside = [&]() {
+    int n = 0;
+    for (const auto& q : a.particles()) {
+      const int cx = static_cast<int>(std::floor((q.pose.x() + 1.0) / 0.05));
+      const int cy = static_cast<int>(std::floor((q.pose.y() + 1.0) / 0.05));
+      n += map->state(cx, cy) != -1;
+    }
+    return n;
+  };
+  a.initGaussian(near_wall, cov);
+  EXPECT_GT(outside(), 300);  // as drawn: many in walls or off the map
+  a.initGaussian(near_wall, cov, true);
+  EXPECT_EQ(outside(), 0);
+  EXPECT_EQ(a.particles().size(), 3000u);
+}
+
 TEST(Amcl, TrackingConvergesOnTheTruePoseFromAnOffsetGuess) {
   const auto map = roomMap();
   AmclParams p;

@@ -107,8 +107,10 @@ class Amcl {
   void setMap(std::shared_ptr<const AmclMap> map);
   bool hasMap() const { return static_cast<bool>(map_); }
 
-  /// max_particles particles drawn from N(mean, cov) (cov: x, y, yaw; yaw wrapped).
-  void initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov);
+  /// max_particles particles drawn from N(mean, cov) (cov: x, y, yaw; yaw wrapped). free_only (with
+  /// a map): a draw outside the map's free cells is drawn again (up to 50 times), so that a wide
+  /// search puts its particles where the robot can be rather than in walls.
+  void initGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& cov, bool free_only = false);
   /// max_particles particles uniformly over the map's free cells with uniform yaw. Throws
   /// std::logic_error without a map or free cells.
   void initUniform();

@@ -125,7 +125,8 @@ class Localizer:
         if self.fit_change == 'lost':
             self.search_from = self.estimate()[0]
             sigma = 0.5 * self.search_radius
-            self.pf.init_gaussian(np.asarray(self.search_from, float), np.diag([sigma ** 2, sigma ** 2, np.pi ** 2]))
+            self.pf.init_gaussian(np.asarray(self.search_from, float), np.diag([sigma ** 2, sigma ** 2, np.pi ** 2]),
+                                  free_only=True)
             self.search = self.search_change = 'near'
         elif self.search == 'near' and self.updates - self.search_started >= self.search_updates:
             self.pf.init_uniform()
