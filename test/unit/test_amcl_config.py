@@ -123,9 +123,11 @@ def test_the_filter_reports_a_scan_fit_that_falls_when_the_robot_is_elsewhere():
     assert pf.last_scan_fit < 0.5
 
 
-def test_localizer_searches_near_the_last_estimate_when_lost_and_finds_the_carried_robot():
-    # A 6 m room with a cupboard in one corner (so that no turn of the room looks the same); the
-    # robot tracked at (3, 3) is carried to (1.6, 2.2), 1.6 m away, while odometry sees nothing.
+def _carry_in_a_room(seed: int):
+    """A 6 m room with a cupboard in one corner (so that no turn of the room looks the same); the
+    robot tracked at (3, 3) is carried to (1.6, 2.2), 1.6 m away, while odometry sees nothing, then
+    drives on along x and back, 0.25 m an update. Returns (fit changes, search changes, the final
+    estimate, the final true x)."""
     world = _core._World2D()
     data = np.zeros((60, 60), np.int8)
     data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100
@@ -140,7 +142,7 @@ def test_localizer_searches_near_the_last_estimate_when_lost_and_finds_the_carri
 
     p = _core._AmclParams()
     p.min_particles, p.max_particles = 500, 3000
-    pf = _core._Amcl(p, 1)
+    pf = _core._Amcl(p, seed)
     pf.set_map(_core._AmclMap(data, 0.1, (0.0, 0.0)))
     pf.init_gaussian(np.array([3.0, 3.0, 0.0]), np.diag([0.01, 0.01, 0.01]))
     loc = Localizer(pf, update_min_d=0.2, update_min_a=0.5, resample_interval=1, search_radius=3.0)
@@ -149,20 +151,26 @@ def test_localizer_searches_near_the_last_estimate_when_lost_and_finds_the_carri
         loc.force_update = True
         loc.update((0.0, 0.0, 0.0), *args, scan(3.0, 3.0), (0.0, 0.0))
     assert not loc.fit.lost and loc.search is None
-    # Carried, it drives on along x and back, 0.25 m an update; odometry counts from where it was.
     changes, searches = [], []
     xs = (list(np.arange(1.6, 4.2, 0.25)) + list(np.arange(4.1, 1.5, -0.25))) * 2
     for x in xs:
         loc.update((x - 1.6, 0.0, 0.0), *args, scan(x, 2.2), (0.0, 0.0))
         changes.append(loc.fit_change)
         searches.append(loc.search_change)
-    assert 'lost' in changes and searches[changes.index('lost')] == 'near', (changes, searches)
-    assert 'found' in changes, changes
-    assert changes.index('found') - changes.index('lost') <= 10, changes
-    est = loc.estimate()[0]
-    assert math.hypot(est[0] - xs[-1], est[1] - 2.2) < 0.3, est
-    assert abs(est[2]) < 0.2
-    assert 'global' not in searches  # found near, no need to look farther
+    return changes, searches, loc.estimate()[0], xs[-1]
+
+
+def test_localizer_searches_near_the_last_estimate_when_lost_and_finds_the_carried_robot():
+    # Ten seeds: one seed says little about a particle filter (with this one room, a quarter of
+    # the seeds settle on a wrong place whichever way the search draws its particles).
+    back = 0
+    for seed in range(1, 11):
+        changes, searches, est, x = _carry_in_a_room(seed)
+        assert 'lost' in changes and searches[changes.index('lost')] == 'near', (seed, changes, searches)
+        assert 'found' in changes, (seed, changes)
+        assert changes.index('found') - changes.index('lost') <= 10, (seed, changes)
+        back += math.hypot(est[0] - x, est[1] - 2.2) < 0.3 and abs(est[2]) < 0.2
+    assert back >= 7, '%d of 10 carries found again within 0.3 m' % back
 
 
 def test_launch_file_names_are_unique_so_roslaunch_by_name_works():
