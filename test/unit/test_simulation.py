@@ -134,6 +134,27 @@ def test_a_person_yields_to_a_robot_then_walks_on_and_it_is_not_the_robots_fault
     assert robot.collisions == 1 and robot.at_fault_collisions == 0
 
 
+def test_a_person_walking_into_a_robot_that_backs_slowly_is_not_the_robots_fault(monkeypatch):
+    # The walker comes along y = -2 at 1 m/s and, its patience spent, walks on; the robot backs
+    # towards it at 0.1 m/s. Which of the two closes the last millimetre is chance (ten times more
+    # often the walker); the walker moved ten times faster into the robot, so it walked into it.
+    # Twenty starts half a millimetre apart put that last millimetre on either side.
+    from mbot_slam_navigation.sim import simulation
+    monkeypatch.setattr(simulation, 'PERSON_PATIENCE', 0.0)
+    at_fault = contacts = 0
+    for k in range(20):
+        sim = Simulation(people_world(), slip_stddev=0.0)
+        robot = sim.spawn('r', robot_spec(), (-1.0 - 0.0005 * k, -2.0, 0.0))  # facing away from the walker
+        for _ in range(int(3.5 / sim.step_size)):
+            sim.command('r', -0.1, 0.0)
+            sim.step()
+            if robot.collisions:
+                break
+        contacts += robot.collisions
+        at_fault += robot.at_fault_collisions
+    assert contacts == 20 and at_fault == 0
+
+
 def test_people_reset_with_the_simulation_and_bad_scripts_name_the_line():
     from mbot_slam_navigation.sim.sdf_world import parse_world
     from mbot_slam_navigation.sim.xmlutil import XmlError

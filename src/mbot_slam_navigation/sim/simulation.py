@@ -7,8 +7,11 @@ People (SDF actors) walk their scripts; lasers see them and robots collide with 
 yields: while its next step would bring it within YIELD_MARGIN of a robot (and closer than it is),
 its script waits; after PERSON_PATIENCE s of waiting it walks on regardless, as Gazebo's actors
 always do, so that nothing waits forever. A contact is the robot's fault only when the robot moved
-into what it touched; a person walking into a robot is counted, but as the person's.
+into what it touched; a person walking into a robot is counted, but as the person's, and so is a
+person who, in the step the two met, walked at the robot farther than the robot moved (which of
+them closed the last millimetre is then chance, not fault).
 """
+import math
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
@@ -31,6 +34,7 @@ class Person:
     actor: Actor
     script_time: float = 0.0          # [s] of its script played (stops while it yields)
     waited: float = 0.0               # [s] yielding so far, without a step
+    closing: float = 0.0              # [m] how much nearer to a robot its last step took it (0: none)
     pose: Pose2D = (0.0, 0.0, 0.0)
     added_at: float = 0.0             # [s] simulated time it came in (0 for the world's, and after a reset)
 
@@ -203,6 +207,7 @@ class Simulation:
         new_contacts = []
         walked_into = self._step_people() if self.people else {}
         for i, r in enumerate(self.robots.values()):
+            v, w = r.drive.linear_velocity, r.drive.angular_velocity
             blocked = r.drive.step(self.step_size, self.time, self.geometry, i)
             touching = blocked or r.name in walked_into
             if touching and not r.in_contact:
@@ -210,7 +215,10 @@ class Simulation:
                     event = ContactEvent(r, walked_into[r.name], 'person', robot_at_fault=False)
                 else:
                     other, kind = self._touched_by(r, i)
-                    event = ContactEvent(r, other, kind, robot_at_fault=True)
+                    # A person who walked at the robot faster than it moved, in the very step the two
+                    # met, walked into it: which of them closed the last millimetre is chance.
+                    walked = kind == 'person' and self.people[other].closing > self._reach(r, v, w)
+                    event = ContactEvent(r, other, kind, robot_at_fault=not walked)
                 r.collisions += 1
                 r.at_fault_collisions += event.robot_at_fault
                 new_contacts.append(event)
@@ -226,6 +234,7 @@ class Simulation:
         walked_into = {}
         for p in self.people.values():
             a = p.actor
+            p.closing = 0.0
             if now < p.added_at + a.delay_start or not a.waypoints:
                 continue
             nx, ny, nyaw = a.pose_at(p.script_time + dt)
@@ -237,6 +246,8 @@ class Simulation:
                     continue
             if ahead >= a.radius + YIELD_MARGIN:
                 p.waited = 0.0  # clear of robots; after a wait, it keeps walking until it is
+            p.closing = max(0.0, self.geometry.distance_to_dynamic_polygons(np.array(p.pose[:2])) - ahead) \
+                if ahead < a.radius + YIELD_MARGIN else 0.0
             p.script_time += dt
             p.pose = (nx, ny, nyaw)
             if ahead < a.radius:
@@ -245,6 +256,12 @@ class Simulation:
                         walked_into[r.name] = p.name
         self._update_people()
         return walked_into
+
+    def _reach(self, robot: Robot, v: float, w: float) -> float:
+        """[m] The most one step at (v, w) takes any point of the robot's footprint nearer to something."""
+        x, y, _ = robot.pose
+        radius = max(math.hypot(px - x, py - y) for px, py in robot.drive.footprint_in_world())
+        return (abs(v) + abs(w) * radius) * self.step_size
 
     def _touched_by(self, robot: Robot, index: int) -> Tuple[str, str]:
         """What a robot that was just stopped touches: ('person name', 'person'), ('robot name',
