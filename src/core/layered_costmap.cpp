@@ -478,6 +478,7 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
   }
   const auto& ob = config_.obstacle_layer;
   if (ob && ob->enabled) {
+    std::vector<Cell> too_close;
     for (std::size_t i = 0; i < observations_.size(); ++i) {
       const auto& src = ob->sources[i];
       ObservationSourceParams p;
@@ -489,7 +490,7 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
       p.too_close_is_obstacle = src.too_close_is_obstacle;
       for (const auto& obs : observations_[i]) {
         // Clearing and marking in one pass per scan, as ObstacleLayer does per cloud.
-        updateWithScan(obstacle_, obs.pose, obs.scan, p);
+        updateWithScan(obstacle_, obs.pose, obs.scan, p, &too_close);
         const double reach = std::min(std::max(src.raytrace_range, src.obstacle_range), obs.scan.range_max_m);
         dirty_ = dirty_.unite(cellsAround(obs.pose.head<2>(), reach + obstacle_.resolution()));
       }
@@ -500,6 +501,9 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
       for (const Cell& cell : footprintCells(obstacle_, robot_pose, config_.footprint)) {
         if (obstacle_.contains(cell)) obstacle_.setCost(cell, cost::kFree);
       }
+      // What covers the laser is not the robot's own body seen by its sensor, which is what
+      // footprint clearing is for: a person who walked into the robot stays marked where it is.
+      for (const Cell& cell : too_close) obstacle_.setCost(cell, cost::kLethal);
       dirty_ = dirty_.unite(cellsAround(robot_pose.head<2>(), config_.circumscribed_radius + obstacle_.resolution()));
     }
   }

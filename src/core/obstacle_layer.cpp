@@ -15,7 +15,7 @@ void ObservationSourceParams::validate() const {
 }
 
 int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const LaserScan& scan,
-                   const ObservationSourceParams& params) {
+                   const ObservationSourceParams& params, std::vector<Cell>* too_close) {
   params.validate();
   const Eigen::Vector2d origin = sensor_pose.head<2>();
   const Cell from = layer.worldToCell(origin);
@@ -29,7 +29,10 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
       if (!params.too_close_is_obstacle || !params.marking) continue;
       const double a = sensor_pose.z() + scan.beamAngle(i);
       const Cell end = layer.worldToCell(origin + scan.range_min_m * Eigen::Vector2d(std::cos(a), std::sin(a)));
-      if (layer.contains(end)) marks.push_back(end);
+      if (layer.contains(end)) {
+        marks.push_back(end);
+        if (too_close) too_close->push_back(end);
+      }
       continue;
     }
     if (std::isnan(r) || r < scan.range_min_m) continue;  // NaN, or a driver's finite error code: nothing known

@@ -279,3 +279,24 @@ def test_a_source_without_expected_update_rate_goes_stale_after_two_seconds_and_
         assert lc.add_scan('scan', 1.0, (0.5, 0.5, 0.0), 0.1, 0.0, 0.1, 0.1, 6.0, [1.0])
         assert lc.stale_sources(2.9) == []
         assert bool(lc.stale_sources(3.1)) == stale_at_3
+
+
+def test_a_laser_covered_by_a_person_is_marked_inside_the_footprint_that_clearing_would_wipe():
+    # A person walked into the robot and covers its laser: every beam -inf (REP 117). The marks at
+    # range_min lie inside the footprint, which footprint clearing empties after each scan (the
+    # robot's own body is no obstacle); these stay, so the robot does not drive on into the person.
+    # Returns beyond them clear them again. too_close_is_obstacle false is costmap_2d's way.
+    for too_close, expect in ((True, LETHAL), (False, FREE)):
+        values = {'static_map': False, 'robot_radius': 0.2, 'width': 3.0, 'height': 3.0, 'observation_sources': 'scan',
+                  'scan': {'data_type': 'LaserScan', 'clearing': True, 'marking': True,
+                           'too_close_is_obstacle': too_close}}
+        lc = LayeredCostmap(CostmapConfig('c', values, lambda w: None), print)
+        pose = (1.5, 1.5, 0.0)
+        ranges = [float('-inf')] * 36
+        assert lc.add_scan('scan', 1.0, pose, 0.1, -math.pi, 2 * math.pi / 36, 0.1, 6.0, ranges)
+        lc.update(pose)
+        ahead = cell_of(lc, 1.6, 1.5)
+        assert costs_of(lc)[ahead[1], ahead[0]] == expect, too_close
+        lc.add_scan('scan', 2.0, pose, 0.1, -math.pi, 2 * math.pi / 36, 0.1, 6.0, [1.0] * 36)
+        lc.update(pose)
+        assert costs_of(lc)[ahead[1], ahead[0]] == FREE

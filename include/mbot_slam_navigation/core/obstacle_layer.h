@@ -13,6 +13,8 @@
 // Frames: `sensor_pose` is the laser in the costmap's global frame (x [m], y [m], yaw [rad]).
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "mbot_slam_navigation/core/costmap.h"
@@ -31,9 +33,11 @@ struct ObservationSourceParams {
   void validate() const;         ///< std::invalid_argument naming the parameter
 };
 
-/// Applies one scan to `layer`; returns the number of cells marked.
+/// Applies one scan to `layer`; returns the number of cells marked. `too_close`, when given,
+/// also receives the cells marked for -inf readings, so that a caller whose footprint clearing
+/// would wipe them (they lie inside the footprint when the laser does) can mark them again after it.
 int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const LaserScan& scan,
-                   const ObservationSourceParams& params);
+                   const ObservationSourceParams& params, std::vector<Cell>* too_close = nullptr);
 
 }  // namespace core
 }  // namespace mbot
