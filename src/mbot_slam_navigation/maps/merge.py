@@ -66,7 +66,7 @@ def merge(grids: Sequence[Tuple[Grid, Pose2]], resolution: Optional[float] = Non
         far = []
         for warped, trail in zip(placed, trails):
             mask = np.full((h, w), 255, np.uint8)
-            px = np.round(np.array([[(x - x0) / res - 0.5, (y - y0) / res - 0.5] for x, y in trail])).astype(np.int32)
+            px = _trail_pixels(trail, (x0, y0), res)
             cv2.polylines(mask, [px], False, 0, 1)
             mask[np.clip(px[:, 1], 0, h - 1), np.clip(px[:, 0], 0, w - 1)] = 0  # a trail of one point
             d = cv2.distanceTransform(mask, cv2.DIST_L2, 5) * res
@@ -134,6 +134,12 @@ def estimate_pose(a: Grid, b: Grid, min_inliers: int = 20) -> Tuple[Optional[Pos
 
 
 
+def _trail_pixels(trail: Sequence[Tuple[float, float]], origin: Tuple[float, float], res: float) -> np.ndarray:
+    """A driven path (world (x, y) points) as the int32 pixel (column, row) of a grid with that origin
+    and resolution, for OpenCV's drawing."""
+    return np.round(np.array([[(x - origin[0]) / res - 0.5, (y - origin[1]) / res - 0.5] for x, y in trail])).astype(np.int32)
+
+
 def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius: float) -> Grid:
     """m with its occupied cells (>= 65) within `radius` [m] of a robot's trail (world (x, y) points
     in the order driven) made free: the robots' bodies stood there, so whatever a robot's laser saw
@@ -146,9 +152,7 @@ def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius
     for trail in trails:
         if not len(trail):
             continue
-        pts = np.array([[(x - m.origin[0]) / m.resolution - 0.5, (y - m.origin[1]) / m.resolution - 0.5]
-                        for x, y in trail])
-        px = np.round(pts).astype(np.int32)
+        px = _trail_pixels(trail, m.origin, m.resolution)
         if len(px) > 1:
             cv2.polylines(mask, [px], False, 1, thickness=2 * r + 1)
         for p in px:
