@@ -14,6 +14,11 @@ namespace core {
 namespace {
 
 constexpr double kSpinSpot_m = 0.05;  // moving less than this counts as turning on the spot
+// [rad] The plan a heading_lookahead ahead lies farther than this off the robot's heading: it turns
+// on the spot first. Only slow forward arcs stay near such a plan, and they end in nearly the same
+// cells (0.05 m in sim_time): their costs tie, the straight one wins, and the robot crept on at
+// min_vel_x while the plan turned away (in the home, 3 to 10 s more per 75 m of goals, measured).
+constexpr double kFacingAway_rad = M_PI / 3.0;
 
 bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
 
@@ -182,7 +187,11 @@ std::vector<Cell> footprintCells(const Costmap& map, const Eigen::Vector3d& pose
 // --- LocalPlanner --------------------------------------------------------------------------------
 
 LocalPlanner::LocalPlanner(const LocalPlannerParams& params, const Footprint& footprint)
-    : params_(params), footprint_(footprint), path_bias_(params.path_distance_bias), goal_bias_(params.goal_distance_bias) {
+    : params_(params),
+      footprint_(footprint),
+      path_bias_(params.path_distance_bias),
+      goal_bias_(params.goal_distance_bias),
+      occ_scale_(params.occdist_scale) {
   params_.validate();
   validateFootprint(footprint_);
   circumscribed_ = circumscribedRadius(footprint_);
@@ -253,6 +262,10 @@ void LocalPlanner::resetOscillation() {
 void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) {
   path_bias_ = params_.path_distance_bias * (params_.meter_scoring ? map.resolution() : 1.0);
   goal_bias_ = params_.goal_distance_bias * (params_.meter_scoring ? map.resolution() : 1.0);
+  // ROS scales the occupancy weight too (TrajectoryPlanner::reconfigure, which the
+  // dynamic_reconfigure server calls at start-up); left unscaled, with meter_scoring it outweighs the
+  // distance terms twentyfold at 0.05 m cells and the robot crawled at min_vel_x near every wall.
+  occ_scale_ = params_.occdist_scale * (params_.meter_scoring ? map.resolution() : 1.0);
   path_grid_.reset(map);
   goal_grid_.reset(map);
   const std::vector<Cell> robot = footprintCells(map, pose, footprint_);
@@ -269,6 +282,22 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
     }
     dense_plan_.push_back(p);
   }
+}
+
+bool LocalPlanner::planAhead(const Eigen::Vector2d& point, double lookahead, Eigen::Vector2d* ahead) const {
+  if (dense_plan_.empty()) return false;
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < dense_plan_.size(); ++i) {
+    if ((dense_plan_[i] - point).squaredNorm() < (dense_plan_[nearest] - point).squaredNorm()) nearest = i;
+  }
+  double along = 0.0;
+  std::size_t i = nearest;
+  while (i + 1 < dense_plan_.size() && along < lookahead) {
+    along += (dense_plan_[i + 1] - dense_plan_[i]).norm();
+    ++i;
+  }
+  *ahead = dense_plan_[i];
+  return true;
 }
 
 int LocalPlanner::alongPlan(const Eigen::Vector2d& point) const {
@@ -357,12 +386,12 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   }
   traj.progress = path_bias_ * path_dist + goal_bias_ * goal_dist;
   const double rest = traj.progress + (p.heading_scoring ? 0.3 * heading : 0.0);
-  traj.cost = rest + p.occdist_scale * occ;  // a lower bound while steps are deferred
+  traj.cost = rest + occ_scale_ * occ;  // a lower bound while steps are deferred
   traj.cost_exact = !deferred;
   if (deferred && traj.cost <= exact_below) {
     // It may win: the outline costs of every step, exactly.
     for (const Eigen::Vector3d& q : traj.points) occ = std::max(occ, static_cast<double>(footprintCost(map, q, footprint_, true)));
-    traj.cost = rest + p.occdist_scale * occ;
+    traj.cost = rest + occ_scale_ * occ;
     traj.cost_exact = true;
   }
 }
@@ -530,6 +559,15 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     spun_ += std::abs(normalizeAngle(pose.z() - spin_yaw_));
   }
   spin_yaw_ = pose.z();
+  // Facing away from the plan (and not already a full turn on the spot without progress): turning
+  // in place is preferred to any forward move, as long as one is valid.
+  bool facing_away = false;
+  Eigen::Vector2d ahead;
+  if (!escaping_ && spun_ <= 2.0 * M_PI && planAhead(pose.head<2>(), p.heading_lookahead, &ahead) &&
+      (ahead - pose.head<2>()).norm() > 2.0 * map.resolution()) {
+    const double bearing = std::atan2(ahead.y() - pose.y(), ahead.x() - pose.x());
+    facing_away = std::abs(normalizeAngle(bearing - pose.z())) > kFacingAway_rad;
+  }
   // Costs at or above this cannot win (the comparisons below are < best and <= best), so only the
   // trajectories that may are scored exactly.
   auto bar = [&]() { return best.cost < 0 || best.yv != 0.0 ? std::numeric_limits<double>::infinity() : best.cost; };
@@ -610,10 +648,12 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   // Rotating in place, towards where the goal distance a heading_lookahead ahead is smallest.
   double heading_dist = std::numeric_limits<double>::max();
   double vth_samp = min_vth;
-  for (int i = 0; i < p.vtheta_samples && !progressing; ++i) {
+  for (int i = 0; i < p.vtheta_samples && (!progressing || facing_away); ++i) {
     const double limited = vth_samp > 0 ? std::max(vth_samp, p.min_in_place_vel_theta) : std::min(vth_samp, -p.min_in_place_vel_theta);
-    generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp, bar());
-    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) && std::abs(vth_samp) > dvth) {
+    generate(map, pose, vel, 0.0, 0.0, limited, impossible, comp,
+             facing_away ? std::numeric_limits<double>::infinity() : bar());  // exact: it may win on heading alone
+    if (comp.cost >= 0 && (facing_away || comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) &&
+        std::abs(vth_samp) > dvth) {
       const double d = goalDistanceAhead(comp);
       if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
         std::swap(best, comp);

@@ -125,9 +125,8 @@ TEST(LocalPlanner, ACentreInAnInscribedCellCanStillTurnOrBackOut) {
 }
 
 TEST(LocalPlanner, ApproachesAGoalNearAWallInsteadOfSpinning) {
-  // The goal is 0.375 m from a wall, inside its inflation: stepping towards it raises the occupancy
-  // term as much as it lowers the distance terms (tutorial biases, meter_scoring), so an in-place
-  // rotation scores as well as the best forward move, and ROS's rule (rotation wins a tie) spins.
+  // The goal is 0.375 m from a wall, inside its inflation: an in-place rotation scores as well as
+  // the best forward move, and ROS's rule (a rotation wins a tie) would spin the robot there.
   Costmap raw(100, 100, 0.05, {0, 0});
   for (int x = 0; x < 100; ++x) raw.setCost({x, 70}, cost::kLethal);  // wall at y = 3.5 m
   const Costmap m = inflated(raw);
@@ -142,7 +141,22 @@ TEST(LocalPlanner, ApproachesAGoalNearAWallInsteadOfSpinning) {
     if (c >= 0) spin = std::min(spin, c);
   }
   ASSERT_LE(spin, t.cost) << "not the situation where ROS's rule spins";
-  EXPECT_GT(t.xv, 0.0) << "spinning on the spot although a forward move gets nearer the goal";
+  // It faces 70 degrees off the plan: it may turn towards it first, but then it drives to the goal
+  // (closed loop at 10 Hz, until within xy_goal_tolerance 0.1 m as move_base stops it), not spin on
+  // the spot. (Before the occupancy weight was scaled by the resolution as ROS scales it, it stopped
+  // 0.27 m short, where the wall's inflation outweighed the last steps.)
+  Eigen::Vector3d p = pose, vel(0, 0, 0);
+  double turned = 0.0;
+  for (int k = 0; k < 150 && (p.head<2>() - Eigen::Vector2d(2.8, 3.125)).norm() > 0.1; ++k) {
+    const Trajectory c = lp.findBestPath(m, p, vel);
+    ASSERT_GE(c.cost, 0.0) << "no command at (" << p.x() << ", " << p.y() << ")";
+    if (c.xv == 0.0) turned += std::abs(c.thetav / 10.0);
+    p = integrateArc(p, c.xv / 10.0, c.thetav / 10.0);
+    vel = {c.xv, 0, c.thetav};
+  }
+  EXPECT_LT((p.head<2>() - Eigen::Vector2d(2.8, 3.125)).norm(), 0.1)
+      << "not at the goal (0.96 m away at the start) after 15 s: at (" << p.x() << ", " << p.y() << ")";
+  EXPECT_LT(turned, M_PI / 2) << "turned " << turned << " rad on the spot to face a plan 70 degrees off";
 }
 
 TEST(LocalPlanner, FollowsAPlanThatRunsDiagonallyAwayFromTheGoalInsteadOfSpinning) {
@@ -356,4 +370,53 @@ TEST(LocalPlanner, ShortcutsChooseExactlyAsTheFullFootprintWalk) {
   }
   EXPECT_EQ(compared, 96);
   EXPECT_GE(valid, 40);
+}
+
+TEST(LocalPlanner, TurnsTowardsAPlanThatLeavesSidewaysInsteadOfCrawling) {
+  // The plan leaves the robot at a right angle (a goal beside it, the way out of a doorway): slow
+  // forward arcs end in the same cells and the straight one won the tie, so the robot crawled
+  // sideways to its plan at min_vel_x (a fifth of an exploration's commands). It turns on the spot
+  // first, then drives at speed.
+  const Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), padFootprint(circleFootprint(0.2), 0.01));
+  lp.setPlan(straightPlan({2.5, 2.5}, {2.5, 4.0}, 0.025));
+  Eigen::Vector3d pose(2.5, 2.5, 0.0), vel(0, 0, 0);
+  const Trajectory first = lp.findBestPath(m, pose, vel);
+  ASSERT_GE(first.cost, 0.0);
+  EXPECT_EQ(first.xv, 0.0) << "drove on (vx " << first.xv << ") facing 90 degrees off the plan";
+  EXPECT_GT(first.thetav, 0.0) << "turned away from the plan";
+  double t = 0.0;
+  for (; t < 10.0 && pose.y() < 3.9; t += 0.1) {
+    const Trajectory c = lp.findBestPath(m, pose, vel);
+    ASSERT_GE(c.cost, 0.0);
+    pose = integrateArc(pose, c.xv / 10.0, c.thetav / 10.0);
+    vel = {c.xv, 0, c.thetav};
+  }
+  // 1.4 m at 0.3 m/s plus a quarter turn: under 8 s; crawling at 0.05 m/s it takes 28 s
+  EXPECT_GE(pose.y(), 3.9) << "at (" << pose.x() << ", " << pose.y() << ") after " << t << " s";
+  EXPECT_LT(t, 8.0);
+}
+
+TEST(LocalPlanner, MeterScoringScalesTheOccupancyWeightByTheResolutionAsRosDoes) {
+  // TrajectoryPlanner::reconfigure (which ROS's dynamic_reconfigure server runs at start-up)
+  // multiplies occdist_scale by the resolution under meter_scoring, as it does the two biases. The
+  // same trajectory over cells of cost 100 instead of 0 costs occdist_scale * 0.05 * 100 = 0.05 more.
+  Costmap free_map(100, 100, 0.05, {0, 0});
+  Costmap costly(100, 100, 0.05, {0, 0});
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x) costly.setCost({x, y}, 100);
+  }
+  for (bool meter : {true, false}) {
+    LocalPlannerParams params = tutorialParams();
+    params.meter_scoring = meter;
+    LocalPlanner lp(params, padFootprint(circleFootprint(0.2), 0.01));
+    lp.setPlan(straightPlan({1.0, 2.5}, {4.5, 2.5}));
+    const Eigen::Vector3d pose(1.0, 2.5, 0.0), vel(0.3, 0, 0), cmd(0.3, 0, 0);
+    lp.updateGrids(free_map, pose);
+    const double base = lp.scoreTrajectory(free_map, pose, vel, cmd);
+    lp.updateGrids(costly, pose);
+    const double more = lp.scoreTrajectory(costly, pose, vel, cmd);
+    ASSERT_GE(base, 0.0);
+    EXPECT_NEAR(more - base, meter ? 0.01 * 0.05 * 100 : 0.01 * 100, 1e-9) << "meter_scoring " << meter;
+  }
 }

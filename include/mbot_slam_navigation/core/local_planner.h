@@ -7,8 +7,9 @@
 // last point to the global plan / to the plan's last point inside the local costmap, and occ is the
 // highest costmap value under the footprint along the trajectory. A trajectory is invalid (-1) if
 // the footprint outline touches a lethal or unknown cell or leaves the map, and (-2) if it enters a
-// cell with no path to the goal. With meter_scoring the two biases are multiplied by the costmap
-// resolution, so the distances count in metres.
+// cell with no path to the goal. With meter_scoring the two biases and occdist_scale are multiplied
+// by the costmap resolution (as ROS's TrajectoryPlanner::reconfigure does), so the distances count
+// in metres.
 // Rotating in place (at least min_in_place_vel_theta, towards the goal) is considered when no
 // forward trajectory gets closer to the plan and goal than the robot is now; then strafes
 // (holonomic), then backing up at escape_vel, with ROS's oscillation flags (no turning back the
@@ -23,6 +24,10 @@
 // degrees, say) no move lowers their sum, and ROS's robot, like ours before, turns on the spot
 // until move_base gives up. Whatever the cause, a robot that has turned a full circle on the spot
 // without finding progress takes its best forward move (a turn more would show it nothing new).
+// The other way round: where the plan heading_lookahead ahead lies more than 60 degrees off the
+// robot's heading, a valid rotation in place is taken even though a slow forward arc would make
+// progress (before, the robot crawled sideways to such a plan at min_vel_x: the slow arcs end in
+// the same cells, and the straight one wins the tie).
 //
 // Frames: every pose is in the local costmap's global frame (x [m], y [m], yaw [rad]); velocities
 // are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
@@ -138,6 +143,9 @@ class LocalPlanner {
   /// Index along the plan (densified to the costmap's cells, as far as it stays on the local map)
   /// of the plan point nearest `point` [m], if one lies within two cells; -1 otherwise.
   int alongPlan(const Eigen::Vector2d& point) const;
+  /// The plan point `lookahead` [m] along the plan (densified, on the local map) from the plan point
+  /// nearest `point`, or the plan's last one; false without a plan on the local map.
+  bool planAhead(const Eigen::Vector2d& point, double lookahead, Eigen::Vector2d* ahead) const;
   /// Recomputes the path and goal distance grids for `pose` without choosing a command.
   void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
   /// Clears the oscillation and escape state (a new goal).
@@ -172,7 +180,7 @@ class LocalPlanner {
 
   LocalPlannerParams params_;
   Footprint footprint_;
-  double path_bias_, goal_bias_;  // scaled by the resolution with meter_scoring (set per cycle)
+  double path_bias_, goal_bias_, occ_scale_;  // scaled by the resolution with meter_scoring (set per cycle)
   std::vector<Eigen::Vector2d> plan_;
   std::vector<Eigen::Vector2d> dense_plan_;  // plan_ at cell spacing, while on the local map (updateGrids)
   double dense_reach_ = 0.0;                 // [m] two cells
