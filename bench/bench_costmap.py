@@ -21,6 +21,11 @@
   in the open, with an inflated doorway ahead, and along a wall; median of 50 cycles, binding
   included, beside the reference that walks every footprint's outline (same choice expected).
   Target: under 5 ms.
+- Local planner driving, closed loop: 30 random goals in the home (seeded), each from a random
+  heading on the ground-truth map inflated as the tutorial's global costmap, the global planner's
+  path, then the local planner at 10 Hz with the tutorial's settings and perfect motion, until within
+  xy_goal_tolerance (0.1 m) or 120 s. Prints seconds per metre of path (median over goals; at
+  max_vel_x 0.3 m/s the floor is 3.3), the time spent creeping at min_vel_x, and goals not reached.
 """
 import json
 import statistics
@@ -188,9 +193,66 @@ def inflation():
               flush=True)
 
 
+def drive_home(goals=30, seed=1):
+    import math
+    import os
+    import yaml
+    from mbot_slam_navigation.sim.ground_truth import rasterize
+    from mbot_slam_navigation.sim.sdf_world import load_world
+    here = os.path.dirname(os.path.abspath(__file__))
+    world = load_world(os.path.join(here, '..', 'worlds', 'mbot_sim_gazebo_navigation.world'))
+    grid, origin = rasterize(world)
+    g = np.where(grid >= 65, 254, 0).astype(np.uint8)
+    _core._inflate(g, 0.05, 0.21, 0.6, 10.0)
+    costmap = _core._Costmap(g, 0.05, np.array(origin))
+    with open(os.path.join(here, '..', 'config', 'base_local_planner_params.yaml')) as f:
+        values = yaml.safe_load(f)['TrajectoryPlannerROS']
+    params, _ = _core.read_local_planner_params(values, 'TrajectoryPlannerROS', None, 10.0)
+    footprint = _core._pad_footprint(_core._circle_footprint(0.2), 0.01)
+    planner = _core._GlobalPlanner()
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(g == 0)
+    per_m, creep, failed, metres, t0 = [], 0.0, 0, 0.0, time.perf_counter()
+    while len(per_m) + failed < goals:
+        a, b = (np.array(origin) + (free[rng.integers(len(free))][::-1] + 0.5) * 0.05 for _ in range(2))
+        _, path, _, _, _ = planner.make_plan(costmap, a, b)
+        if len(path) < 2:
+            continue
+        length = float(np.sum(np.hypot(*np.diff(path, axis=0).T)))
+        lp = _core._LocalPlanner(params, footprint)
+        pose, vel, t = np.array([a[0], a[1], rng.uniform(-math.pi, math.pi)]), np.zeros(3), 0.0
+        while np.hypot(*(pose[:2] - b)) > 0.1 and t < 120.0:
+            nearest = int(np.argmin(np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])))
+            lp.set_plan(list(path[nearest:]))  # pruned as move_base prunes it
+            cmd, cost, _ = lp.find_best_path(costmap, pose, vel)
+            if cost < 0:
+                break
+            vx, vth = cmd[0], cmd[2]
+            creep += 0.1 if abs(vx - params.min_vel_x) < 1e-3 else 0.0
+            th = pose[2] + vth * 0.1
+            if abs(vth) < 1e-9:
+                pose = np.array([pose[0] + vx * 0.1 * math.cos(pose[2]), pose[1] + vx * 0.1 * math.sin(pose[2]), th])
+            else:
+                r = vx / vth
+                pose = np.array([pose[0] + r * (math.sin(th) - math.sin(pose[2])),
+                                 pose[1] - r * (math.cos(th) - math.cos(pose[2])), th])
+            vel, t = np.array([vx, 0.0, vth]), t + 0.1
+        if np.hypot(*(pose[:2] - b)) > 0.1:
+            failed += 1
+            continue
+        per_m.append(t / max(length, 0.1))
+        metres += length
+    print(json.dumps(dict(benchmark='local_planner', metric='driving in the home, closed loop, tutorial settings',
+                          value=round(statistics.median(per_m), 2), unit='s per m', target='near 3.3 (max_vel_x)',
+                          note='median over %d goals (%.0f m of path), seed %d; %.0f s creeping at min_vel_x; %d not '
+                               'reached in 120 s; %.0f s of wall time' % (len(per_m), metres, seed, creep, failed,
+                                                                          time.perf_counter() - t0))), flush=True)
+
+
 def main():
     inflation()
     local_cycles()
+    drive_home()
     plans()
 
 
