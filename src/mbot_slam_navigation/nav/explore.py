@@ -76,6 +76,20 @@ from mbot_slam_navigation.transforms import quaternion_to_yaw
 BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot is stuck, not done
 
 
+def sim_sleep(seconds: float, poll: float = 0.02) -> None:
+    """Sleeps `seconds` of ROS time (simulated under /use_sim_time) by polling the wall clock every
+    `poll` s. rospy.sleep wakes its thread at every /clock message (100 Hz simulated, so 800 times a
+    wall second at 8x real time) only to sleep again. Returns early on shutdown or when time jumps
+    back (a simulation reset)."""
+    start = rospy.Time.now()
+    end = start + rospy.Duration(seconds)
+    while not rospy.is_shutdown():
+        now = rospy.Time.now()
+        if now >= end or now < start:
+            return
+        time.sleep(poll)
+
+
 def grid_of(msg: OccupancyGrid) -> Grid:
     return Grid(np.asarray(msg.data, np.int8).reshape(msg.info.height, msg.info.width), msg.info.resolution,
                 (msg.info.origin.position.x, msg.info.origin.position.y))
@@ -129,6 +143,7 @@ class Explore:
         self.collisions = 0
         self.start_time: Optional[rospy.Time] = None  # set when exploring starts
         self.path: List[Tuple[float, float]] = []
+        self.path_time = -math.inf                     # [s] ROS time of the path's last point
         self.goals: List[Tuple[float, float, bool]] = []  # (x, y, reached)
         self.curve: List[Tuple[float, float]] = []         # (simulated s since start, known m^2)
         self.given_up: List[GivenUp] = []
@@ -218,10 +233,15 @@ class Explore:
         except (rospy.ServiceException, rospy.ROSException) as e:
             rospy.logwarn_throttle(30.0, 'explore: move_base/clear_costmaps failed: %s' % e)
 
-    def record_path(self, _event) -> None:
-        pose = self.robot_pose()
+    def record_path(self, pose=None) -> None:
+        """Adds the robot's position to its path, every 0.5 s (ROS time) at most."""
+        now = rospy.Time.now().to_sec()
+        if now - self.path_time < 0.5 and now >= self.path_time:
+            return
+        pose = pose or self.robot_pose()
         if pose is not None:
             self.path.append(pose[:2])
+            self.path_time = now
 
     def send(self, x: float, y: float, yaw: float) -> None:
         g = MoveBaseGoal()
@@ -300,7 +320,6 @@ class Explore:
             return
         self.start_time = rospy.Time.now()
         wall0 = time.monotonic()
-        rospy.Timer(rospy.Duration(0.5), self.record_path)
         rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
         outcome = self.explore(wall0)
         if outcome is not None:
@@ -319,8 +338,9 @@ class Explore:
                 return 'timeout'
             pose = self.robot_pose()
             if pose is None:
-                rospy.sleep(self.period)
+                sim_sleep(self.period)
                 continue
+            self.record_path(pose)
             self.motion.update(now, pose[:2])
             if self.motion.still_for(now) == 0.0:
                 escapes_failed = 0  # it moved: an earlier failed escape says nothing about here
@@ -407,11 +427,25 @@ class Explore:
     def wait_cycle(self) -> None:
         """Until the next planning cycle: 1/planner_frequency, or sooner when move_base finishes the
         goal (the robot would otherwise stand at a reached goal for up to a whole period)."""
-        end = rospy.Time.now() + rospy.Duration(self.period)
-        while not rospy.is_shutdown() and rospy.Time.now() < end:
+        start = rospy.Time.now()
+        end = start + rospy.Duration(self.period)
+        while not rospy.is_shutdown() and start <= rospy.Time.now() < end:
             if self.state.goal is not None and self.move_base.simple_state == SimpleGoalState.DONE:
                 return
-            rospy.sleep(min(0.25, self.period))
+            self.record_path()
+            sim_sleep(min(0.25, self.period))
+
+    def wait_for_goal(self, timeout: float) -> bool:
+        """Waits up to `timeout` [s, ROS time] for move_base to finish the goal, recording the path;
+        True if it did."""
+        start = rospy.Time.now()
+        end = start + rospy.Duration(timeout)
+        while not rospy.is_shutdown() and start <= rospy.Time.now() < end:
+            if self.move_base.simple_state == SimpleGoalState.DONE:
+                return True
+            self.record_path()
+            sim_sleep(0.25)
+        return self.move_base.simple_state == SimpleGoalState.DONE
 
     def elapsed(self) -> float:
         """[s] simulated (ROS) time since the exploration started."""
@@ -451,24 +485,24 @@ class Explore:
 
     def drive_to(self, target: Tuple[float, float]) -> Tuple[bool, str]:
         """Drives straight for `target` (map frame), forwards or backwards, whichever faces it."""
-        rate = rospy.Rate(10.0)
         t_end = self.elapsed() + self.escape_timeout
         while not rospy.is_shutdown() and self.elapsed() < t_end:
             pose = self.robot_pose()
             if pose is None:
-                rate.sleep()
+                sim_sleep(0.1)
                 continue
+            self.record_path(pose)
             points = self.scan_points()
             if points is None:  # never drive blind
                 rospy.logwarn_throttle(5.0, 'explore: waiting for a scan on %s to back out safely'
                                        % rospy.resolve_name(self.scan_topic))
-                rate.sleep()
+                sim_sleep(0.1)
                 continue
             cmd, why = escape_command(pose, target, points, self.robot_radius, self.escape_speed)
             if cmd is None:
                 return why == 'arrived', why
             self.cmd_pub.publish(Twist(linear=Vector3(cmd[0], 0.0, 0.0), angular=Vector3(0.0, 0.0, cmd[1])))
-            rate.sleep()
+            sim_sleep(0.1)
         return False, 'did not get there within %.0f s' % self.escape_timeout
 
     def scan_points(self) -> Optional[np.ndarray]:
@@ -509,7 +543,7 @@ class Explore:
         elif self.return_to_start:
             rospy.loginfo('explore: returning to the start pose (%.2f, %.2f)', start[0], start[1])
             self.send(*start)
-            if not self.move_base.wait_for_result(rospy.Duration(self.return_timeout)):
+            if not self.wait_for_goal(self.return_timeout):
                 rospy.logwarn('explore: not back at the start after %.0f s; stopping there' % self.return_timeout)
                 self.move_base.cancel_goal()
             pose = self.robot_pose()
