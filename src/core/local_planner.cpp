@@ -17,7 +17,7 @@ constexpr double kSpinSpot_m = 0.05;  // moving less than this counts as turning
 // [rad] The plan a heading_lookahead ahead lies farther than this off the robot's heading: it turns
 // on the spot first. Only slow forward arcs stay near such a plan, and they end in nearly the same
 // cells (0.05 m in sim_time): their costs tie, the straight one wins, and the robot crept on at
-// min_vel_x while the plan turned away (in the home, 3 to 10 s more per 75 m of goals, measured).
+// min_vel_x while the plan turned away (in the home, about 5 s more over 75-90 m of goals, measured).
 constexpr double kFacingAway_rad = M_PI / 3.0;
 
 bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
