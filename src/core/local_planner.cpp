@@ -284,25 +284,9 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
   }
 }
 
-bool LocalPlanner::planAhead(const Eigen::Vector2d& point, double lookahead, Eigen::Vector2d* ahead) const {
-  if (dense_plan_.empty()) return false;
-  std::size_t nearest = 0;
-  for (std::size_t i = 1; i < dense_plan_.size(); ++i) {
-    if ((dense_plan_[i] - point).squaredNorm() < (dense_plan_[nearest] - point).squaredNorm()) nearest = i;
-  }
-  double along = 0.0;
-  std::size_t i = nearest;
-  while (i + 1 < dense_plan_.size() && along < lookahead) {
-    along += (dense_plan_[i + 1] - dense_plan_[i]).norm();
-    ++i;
-  }
-  *ahead = dense_plan_[i];
-  return true;
-}
-
-int LocalPlanner::alongPlan(const Eigen::Vector2d& point) const {
+int LocalPlanner::nearestPlanIndex(const Eigen::Vector2d& point, double within) const {
   int best = -1;
-  double best_d2 = dense_reach_ * dense_reach_;
+  double best_d2 = within * within;
   for (std::size_t i = 0; i < dense_plan_.size(); ++i) {
     const double d2 = (dense_plan_[i] - point).squaredNorm();
     if (d2 <= best_d2) {
@@ -312,6 +296,21 @@ int LocalPlanner::alongPlan(const Eigen::Vector2d& point) const {
   }
   return best;
 }
+
+bool LocalPlanner::planAhead(const Eigen::Vector2d& point, double lookahead, Eigen::Vector2d* ahead) const {
+  const int nearest = nearestPlanIndex(point, std::numeric_limits<double>::infinity());
+  if (nearest < 0) return false;
+  double along = 0.0;
+  std::size_t i = static_cast<std::size_t>(nearest);
+  while (i + 1 < dense_plan_.size() && along < lookahead) {
+    along += (dense_plan_[i + 1] - dense_plan_[i]).norm();
+    ++i;
+  }
+  *ahead = dense_plan_[i];
+  return true;
+}
+
+int LocalPlanner::alongPlan(const Eigen::Vector2d& point) const { return nearestPlanIndex(point, dense_reach_); }
 
 double LocalPlanner::headingDiff(const Costmap& map, const Cell& cell, const Eigen::Vector3d& pose) const {
   // The farthest plan point in line of sight (no lethal/inscribed/unknown cell in between).

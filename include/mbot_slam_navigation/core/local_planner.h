@@ -204,6 +204,9 @@ class LocalPlanner {
   double min_lethal_distance_ = std::numeric_limits<double>::infinity();
   double inside_distance_ = std::numeric_limits<double>::infinity();
   double nearestLethal(const Costmap& map, const Eigen::Vector2d& at, double within) const;
+  /// Index of the densified plan point nearest `point` [m] within `within` [m] (the later one on a
+  /// tie); -1 if none.
+  int nearestPlanIndex(const Eigen::Vector2d& point, double within) const;
   /// Swaps in the escape footprint when the whole one touches a lethal cell at `pose` (see the
   /// .cpp); returns the whole footprint for restoreFootprint.
   Footprint useEscapeFootprint(const Costmap& map, const Eigen::Vector3d& pose);

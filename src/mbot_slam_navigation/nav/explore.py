@@ -427,25 +427,19 @@ class Explore:
     def wait_cycle(self) -> None:
         """Until the next planning cycle: 1/planner_frequency, or sooner when move_base finishes the
         goal (the robot would otherwise stand at a reached goal for up to a whole period)."""
-        start = rospy.Time.now()
-        end = start + rospy.Duration(self.period)
-        while not rospy.is_shutdown() and start <= rospy.Time.now() < end:
-            if self.state.goal is not None and self.move_base.simple_state == SimpleGoalState.DONE:
-                return
-            self.record_path()
-            sim_sleep(min(0.25, self.period))
+        self.wait_for_goal(self.period, watch=self.state.goal is not None)
 
-    def wait_for_goal(self, timeout: float) -> bool:
-        """Waits up to `timeout` [s, ROS time] for move_base to finish the goal, recording the path;
-        True if it did."""
+    def wait_for_goal(self, timeout: float, watch: bool = True) -> bool:
+        """Waits up to `timeout` [s, ROS time], recording the path; with `watch`, only until move_base
+        has finished the goal. True if it has (and `watch`)."""
         start = rospy.Time.now()
         end = start + rospy.Duration(timeout)
         while not rospy.is_shutdown() and start <= rospy.Time.now() < end:
-            if self.move_base.simple_state == SimpleGoalState.DONE:
+            if watch and self.move_base.simple_state == SimpleGoalState.DONE:
                 return True
             self.record_path()
-            sim_sleep(0.25)
-        return self.move_base.simple_state == SimpleGoalState.DONE
+            sim_sleep(min(0.25, timeout))
+        return watch and self.move_base.simple_state == SimpleGoalState.DONE
 
     def elapsed(self) -> float:
         """[s] simulated (ROS) time since the exploration started."""
