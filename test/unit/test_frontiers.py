@@ -7,7 +7,7 @@ import pytest
 
 from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, Teammate, frontier_groups,
-                                                rank_frontiers, share_out, yields_goal)
+                                                rank_frontiers, share_out, tour_order, yields_goal)
 
 RES = 0.05
 
@@ -123,6 +123,18 @@ def test_state_keeps_its_goal_unless_clearly_beaten():
     moved.cells = np.array([[5.0, 5.0], [5.5, 5.0]])
     assert s.choose(9.0, [moved], (0.0, 0.0)) is moved          # same frontier, goal moved: follow it
     assert s.choose(12.0, [], (0.0, 0.0)) is None and s.goal is None
+
+
+def test_another_frontier_with_the_goal_being_driven_to_is_not_a_new_goal():
+    s = ExploreState(hysteresis=1.0, max_goals_per_place=2)
+    a = frontier_at(2.0, 1.0, cost=6.0)
+    assert s.choose(0.0, [a], (0.0, 0.0)) is a
+    for k in range(1, 5):
+        # the frontier split: a second group of cells far from the goal, served by the same goal cell
+        other = Frontier(np.array([[2.0, 2.5 + 0.01 * k]]), 3.0, (2.02, 1.0), 1.5, 1.5)
+        assert s.choose(3.0 * k, [other, a], (0.0, 0.0)) is None
+    assert s.goals_chosen == 1
+    assert s.screen(15.0, [a])[0] == [a]  # not given up as "sent again and again"
 
 
 def test_failures_blacklist_expire_and_then_stick():
@@ -284,6 +296,29 @@ def test_two_frontiers_pulling_the_robot_to_and_fro_end_after_max_goals_per_plac
 
 def _frontier_at(x, y, path_m, size_m=2.0, potential_scale=3.0):
     return Frontier(np.array([[x, y]]), size_m, (x, y), path_m, potential_scale * path_m - size_m)
+
+
+def test_the_tour_finishes_the_dead_end_side_before_crossing_to_the_other():
+    # a corridor 10 m long; the robot at x = 5; a small frontier 1 m west at the dead end, three
+    # east: greedy goes east first (0.8 m) and must come all the way back for the west one
+    passable = np.zeros((20, 220), np.uint8)
+    passable[5:15, 5:215] = 1
+    grid = Grid(passable.astype(np.int8), RES, (0.0, 0.0))
+    west = _frontier_at(4.0, 0.5, 1.0, size_m=1.0)
+    east = [_frontier_at(x, 0.5, x - 5.0, size_m=1.0) for x in (5.8, 7.0, 8.5)]
+    greedy = sorted([west] + east, key=lambda f: f.cost)
+    assert greedy[0].goal == (5.8, 0.5)
+    toured = tour_order([west] + east, passable, grid)
+    assert toured[0].goal == (4.0, 0.5)
+    # its cost: its own plus the tour on from it (west end to 8.5 m: 4.5 m), potential_scale 3
+    assert toured[0].cost == pytest.approx(west.cost + 3.0 * 4.5, abs=0.3)
+    # a wall across the corridor at x = 6 with a door at its far end: the tour measures paths, not lines
+    walled = passable.copy()
+    walled[5:13, 119:121] = 0
+    assert tour_order([west] + east, walled, grid)[0].goal == (4.0, 0.5)
+    # one frontier, or tours switched off: unchanged
+    assert tour_order([west], passable, grid) == [west]
+    assert tour_order(greedy, passable, grid, size=0) == greedy
 
 
 def test_a_team_shares_the_frontiers_out():
