@@ -130,6 +130,46 @@ std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vec
   return out;
 }
 
+std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
+                                           double voxel_m) {
+  std::vector<Eigen::Vector2d> out;
+  if (!(voxel_m > 0.0)) return matchPoints(scan, laser_pose, max_range_m, voxel_m);
+  out.reserve(2 * scan.ranges_m.size());
+  std::unordered_set<uint64_t> seen;
+  auto add = [&](const Eigen::Vector2d& p) {
+    const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
+    const uint64_t key = (static_cast<uint64_t>(kx) << 32) ^ (static_cast<uint64_t>(ky) & 0xffffffffu);
+    if (seen.insert(key).second) out.push_back(p);
+  };
+  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
+  const double step = std::abs(scan.angle_increment_rad);
+  bool have_last = false;
+  Eigen::Vector2d last;
+  double last_r = 0.0;
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r <= 0.0 || r < scan.range_min_m || r >= limit) {
+      have_last = false;  // only neighbouring beams make a surface
+      continue;
+    }
+    const double a = laser_pose.z() + scan.beamAngle(i);
+    const Eigen::Vector2d p = laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    if (have_last) {
+      const double gap = (p - last).norm();
+      const double max_gap = std::min(0.3, std::max(2.0 * voxel_m, 4.0 * std::max(r, last_r) * step));
+      if (gap > voxel_m && gap <= max_gap) {
+        const int n = static_cast<int>(gap / voxel_m);
+        for (int k = 1; k <= n; ++k) add(last + (p - last) * (static_cast<double>(k) / (n + 1)));
+      }
+    }
+    add(p);
+    last = p;
+    last_r = r;
+    have_last = true;
+  }
+  return out;
+}
+
 namespace {
 struct Candidate {
   int rotation;
@@ -243,18 +283,26 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
 }
 
 Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
-                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score) {
+                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score,
+                            double prior_weight) {
   Eigen::Vector3d current = init;
-  double best = grid.score(points, current);
+  auto objective = [&](const Eigen::Vector3d& p, double* plain) {
+    *plain = grid.score(points, p);
+    return *plain - prior_weight * (p.head<2>() - init.head<2>()).squaredNorm();
+  };
+  double plain = 0.0;
+  double best = objective(current, &plain);
+  double best_plain = plain;
   double l = 0.5 * grid.resolution(), a = angular_step_rad;
   static const double kMoves[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (int round = 0; round <= halvings;) {
     bool improved = false;
     for (const auto& m : kMoves) {
       const Eigen::Vector3d c(current.x() + m[0] * l, current.y() + m[1] * l, normalizeAngle(current.z() + m[2] * a));
-      const double s = grid.score(points, c);
+      const double s = objective(c, &plain);
       if (s > best) {
         best = s;
+        best_plain = plain;
         current = c;
         improved = true;
       }
@@ -265,7 +313,7 @@ Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen:
       ++round;
     }
   }
-  if (score) *score = best;
+  if (score) *score = best_plain;
   return current;
 }
 

@@ -43,6 +43,8 @@ void GraphSlamParams::validate() const {
   if (!(local_search_window >= 0.0)) throw std::invalid_argument("local_search_window must be >= 0");
   if (!(local_search_angle >= 0.0)) throw std::invalid_argument("local_search_angle must be >= 0");
   if (!(local_min_score >= 0.0 && local_min_score <= 1.0)) throw std::invalid_argument("local_min_score must lie in [0, 1]");
+  if (!(local_prior_margin >= 0.0 && local_prior_margin < 1.0)) throw std::invalid_argument("local_prior_margin must lie in [0, 1)");
+  if (!(local_prior_weight >= 0.0)) throw std::invalid_argument("local_prior_weight must be >= 0");
   at_least(submap_nodes, 1, "submap_nodes");
   positive(loop_search_radius, "loop_search_radius");
   if (!(loop_search_growth >= 0.0)) throw std::invalid_argument("loop_search_growth must be >= 0");
@@ -108,7 +110,22 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
   if (!first) {
     // Every scan is tracked against the local map, so that the next node's prediction is a few
     // tenths of a second of odometry old, not a whole update's worth.
-    tracked = matchLocally(composePose(track_pose_, relativePose(track_odom_, odom)), *points);
+    Eigen::Vector3d since_node;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      since_node = relativePose(nodes_.back().odom, odom);
+    }
+    // What lies farther than the newest node of the local map could see is not in that map: those
+    // returns (the far end of a corridor walls, coming into range as the robot drives on) would
+    // pull the match back towards where the map ends, and the map shrank along every corridor.
+    const double gate = reach - since_node.head<2>().norm() - params_.local_search_window;
+    const Eigen::Vector2d laser = params_.matcher.laser_pose.head<2>();
+    std::vector<Eigen::Vector2d> near;
+    near.reserve(points->size());
+    for (const auto& p : *points) {
+      if ((p - laser).norm() <= gate) near.push_back(p);
+    }
+    tracked = matchLocally(composePose(track_pose_, relativePose(track_odom_, odom)), near);
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -224,7 +241,16 @@ void GraphSlam::mergeLocked(int k) {
 void GraphSlam::rebuildLocalMapLocked() {
   std::vector<Eigen::Vector2d> reference;
   const int n = static_cast<int>(nodes_.size());
-  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) appendMoved(*nodes_[k].points, nodes_[k].pose, reference);
+  const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
+  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
+    // Walls as surfaces, not as the beams' hits (surfacePoints): else a scan tracked in this map
+    // is pulled back towards where the nodes saw from, and the map shrinks along every corridor.
+    if (nodes_[k].scan) {
+      appendMoved(surfacePoints(*nodes_[k].scan, params_.matcher.laser_pose, reach, params_.delta), nodes_[k].pose, reference);
+    } else {
+      appendMoved(*nodes_[k].points, nodes_[k].pose, reference);
+    }
+  }
   // Under the lock with the node that it ends with, so that currentPose() never sees a new node
   // with the old anchor.
   local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, params_.match_sigma);
@@ -254,6 +280,17 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.local_match_failures;
     return predicted;
+  }
+  if (params_.local_prior_margin > 0.0) {
+    // The local optimum nearest the prediction, if nearly as good: odometry decides what the scan
+    // leaves open, the scan what it fixes (the climb follows every slope the scan has).
+    double near_score = 0.0;
+    const Eigen::Vector3d near = refineMatch(grid, points, predicted, 0.005, 4, &near_score, params_.local_prior_weight);
+    if (near_score >= (1.0 - params_.local_prior_margin) * score &&
+        (near.head<2>() - predicted.head<2>()).cwiseAbs().maxCoeff() <= params_.local_search_window &&
+        std::abs(normalizeAngle(near.z() - predicted.z())) <= params_.local_search_angle) {
+      return near;
+    }
   }
   return refined;
 }

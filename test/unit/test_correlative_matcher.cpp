@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -125,4 +126,29 @@ TEST(CorrelativeMatcher, PointsSkipInvalidAndFarReturnsAndThinOut) {
 TEST(CorrelativeMatcher, RejectsBadGridParameters) {
   EXPECT_THROW(LikelihoodGrid({}, 0.0, 0.05), std::invalid_argument);
   EXPECT_THROW(LikelihoodGrid({}, 0.05, -1.0), std::invalid_argument);
+}
+
+TEST(CorrelativeMatcher, SurfacePointsFillAWallSeenAtAGrazingAngleButNotAGapBehindAnEdge) {
+  // Beams 1 degree apart from the origin: 0..9 on a wall along y = 1 seen at 20-29 degrees (hits
+  // 0.06-0.14 m apart), 10..14 on a wall 3 m farther (a depth jump of metres: never filled).
+  LaserScan s;
+  s.angle_min_rad = 0.35;
+  s.angle_increment_rad = M_PI / 180.0;
+  s.range_min_m = 0.1;
+  s.range_max_m = 20.0;
+  for (int i = 0; i < 10; ++i) s.ranges_m.push_back(1.0 / std::sin(s.angle_min_rad + i * s.angle_increment_rad));
+  for (int i = 10; i < 15; ++i) s.ranges_m.push_back(3.0 + 1.0 / std::sin(s.angle_min_rad + i * s.angle_increment_rad));
+  const auto hits = matchPoints(s, Eigen::Vector3d::Zero(), 20.0, 0.05);
+  const auto surface = surfacePoints(s, Eigen::Vector3d::Zero(), 20.0, 0.05);
+  ASSERT_EQ(hits.size(), 15u);
+  EXPECT_GT(surface.size(), hits.size() + 10);
+  double widest_on_wall = 0.0;
+  std::vector<double> xs;
+  for (const auto& p : surface) {
+    EXPECT_TRUE(std::abs(p.y() - 1.0) < 0.02 || p.norm() > 3.5) << "a filled point off both surfaces: " << p.transpose();
+    if (std::abs(p.y() - 1.0) < 0.02) xs.push_back(p.x());
+  }
+  std::sort(xs.begin(), xs.end());
+  for (std::size_t i = 1; i < xs.size(); ++i) widest_on_wall = std::max(widest_on_wall, xs[i] - xs[i - 1]);
+  EXPECT_LE(widest_on_wall, 0.1) << "the wall seen at a grazing angle should be continuous (hits alone: 0.14 m apart)";
 }

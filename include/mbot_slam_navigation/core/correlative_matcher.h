@@ -82,6 +82,14 @@ struct MatchResult {
 std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
                                          double voxel_m);
 
+/// matchPoints, and the surface between two neighbouring beams' returns filled in every `voxel_m`
+/// where the returns lie no farther apart than a surface seen at a grazing angle would put them
+/// (4 beam spacings at their range, 0.3 m at most, 2 voxel_m at least): a wall far down a corridor
+/// is hit only every few decimetres, and a map made of those hits alone scores a scan higher the
+/// nearer it is moved to where the map was seen from. For the local map that scans are tracked in.
+std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
+                                           double voxel_m);
+
 /// The best pose of `points` (base frame) in `window` around `init`, if one scores above
 /// `min_score`. Candidates within `exclude_radius_m` / `exclude_angle_rad` of `exclude` (when
 /// `exclude` is given) are skipped: used to look for a second, different good match.
@@ -91,9 +99,12 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
                                 double exclude_angle_rad = 0.0);
 
 /// Hill-climbs the interpolated score from `init` with steps from half a cell and `angular_step`,
-/// halved `halvings` times; returns the pose and writes its score.
+/// halved `halvings` times; returns the pose and writes its score. With `prior_weight` > 0 it climbs
+/// score - prior_weight * |xy - init xy|^2 [1/m^2] instead (a pull back to `init` where the score is
+/// nearly flat) and still writes the plain score.
 Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
-                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score);
+                            const Eigen::Vector3d& init, double angular_step_rad, int halvings, double* score,
+                            double prior_weight = 0.0);
 
 }  // namespace core
 }  // namespace mbot

@@ -79,6 +79,14 @@ struct GraphSlamParams {
   double local_search_window = 0.15; ///< [m] +- x, y around the odometry prediction (`~local_search_window`)
   double local_search_angle = 0.15; ///< [rad] +- yaw (`~local_search_angle`)
   double local_min_score = 0.25;    ///< below: keep the odometry prediction (`~local_min_score`)
+  /// The match climbed from the odometry prediction, held to it by `local_prior_weight`, is kept
+  /// when it scores within this fraction of the best match in the window (`~local_prior_margin`):
+  /// where the scan does not fix the pose (along a corridor) the best score is one of many nearly
+  /// equal ones, and the map, seen from behind the robot, scores a little higher the farther back
+  /// the scan is put; taking it shrank the map along every corridor. 0 always takes the best.
+  double local_prior_margin = 0.03;
+  /// [1/m^2] score lost per square metre away from the prediction in that climb (`~local_prior_weight`).
+  double local_prior_weight = 5.0;
   int submap_nodes = 10;            ///< nodes per loop-closure submap (`~submap_nodes`)
   double loop_search_radius = 2.0;  ///< [m] search radius right after a closure (`~loop_search_radius`)
   double loop_search_growth = 0.05; ///< [m per m travelled] radius growth (`~loop_search_growth`)
