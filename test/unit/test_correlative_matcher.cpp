@@ -152,3 +152,15 @@ TEST(CorrelativeMatcher, SurfacePointsFillAWallSeenAtAGrazingAngleButNotAGapBehi
   for (std::size_t i = 1; i < xs.size(); ++i) widest_on_wall = std::max(widest_on_wall, xs[i] - xs[i - 1]);
   EXPECT_LE(widest_on_wall, 0.1) << "the wall seen at a grazing angle should be continuous (hits alone: 0.14 m apart)";
 }
+
+TEST(CorrelativeMatcher, TheInterpolatedScorePeaksOnAWallThatLiesOnACellBorder) {
+  // A wall along y = 1.0, the border between two rows of 0.05 m cells: bilinear interpolation is
+  // flat between the two cell centres (0.975 and 1.025), so a scan could sit 2.5 cm off at no cost.
+  std::vector<Eigen::Vector2d> wall;
+  for (double x = 0.0; x <= 2.0; x += 0.05) wall.emplace_back(x, 1.0);
+  const LikelihoodGrid grid(wall, 0.05, 0.075);
+  const double on = grid.interpolated({1.0, 1.0});
+  EXPECT_GT(on, grid.interpolated({1.0, 0.985}) + 0.005);
+  EXPECT_GT(on, grid.interpolated({1.0, 1.015}) + 0.005);
+  EXPECT_NEAR(grid.interpolated({1.0, 0.985}), grid.interpolated({1.0, 1.015}), 1e-3);
+}

@@ -11,7 +11,7 @@
 // translations on max-pooled copies of the grid (an upper bound of every pose in the block) and
 // only descends into blocks whose bound beats the best pose found so far (Hess, Kohler, Rapp,
 // Andor, "Real-Time Loop Closure in 2D LIDAR SLAM", ICRA 2016, section V). refine() then climbs the
-// bilinearly interpolated score below the grid's resolution.
+// bicubically interpolated score below the grid's resolution.
 //
 // Frames: the grid and every pose live in one "reference" frame (the map frame for local
 // matching, a submap's anchor node for loop closure); scan points are in the robot base frame.
@@ -42,7 +42,8 @@ class LikelihoodGrid {
   int value(int x, int y) const {
     return (x < 0 || y < 0 || x >= width_ || y >= height_) ? 0 : cells_[static_cast<std::size_t>(y) * width_ + x];
   }
-  /// Bilinear interpolation of the values at a point of the reference frame, in [0, 1].
+  /// Bicubic (Catmull-Rom) interpolation of the values at a point of the reference frame, about
+  /// [0, 1] (cubic convolution may overshoot by a few percent next to a peak).
   double interpolated(const Eigen::Vector2d& p) const;
   /// Mean interpolated value of the points moved by `pose`, in [0, 1] (0 for no points).
   double score(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose) const;
