@@ -2,16 +2,47 @@
 ROS 1's actionlib is archived). send_goal registers the goal before it stores the handle, so a
 status that arrives in between is dropped with "Got a transition callback on a goal handle that
 we're not tracking"; when the dropped transition is the last one (a goal the server aborts at
-once), wait_for_result waits out its whole timeout. Here callbacks wait until send_goal is done."""
+once), wait_for_result waits out its whole timeout. Here callbacks wait until send_goal is done.
+
+wait_for_server counts its timeout in wall-clock seconds. actionlib's counts ROS time: under a
+simulator running 20x real time, 60 s was 3 s of wall time, less than connecting to a server takes
+on a loaded machine (random_navigation gave up on a running move_base in a rostest that way), and
+while /clock stands still it waited for ever."""
 import threading
+import time
 
 import actionlib
+import rospy
 
 
 class SimpleActionClient(actionlib.SimpleActionClient):
     def __init__(self, ns, action_spec):
         super().__init__(ns, action_spec)
         self._sending = threading.RLock()
+
+    def wait_for_server(self, timeout=rospy.Duration()):
+        """True once the server is connected; False after `timeout` [wall-clock s] (0: no limit)
+        or at shutdown."""
+        end = time.monotonic() + timeout.to_sec()
+        while not rospy.is_shutdown():
+            if self._server_connected():
+                return True
+            if timeout.to_sec() > 0.0 and time.monotonic() >= end:
+                return False
+            time.sleep(0.01)
+        return False
+
+    def _server_connected(self) -> bool:
+        """actionlib's test of a started server: a status message came, and the goal and cancel
+        publishers and the result and feedback subscribers are connected to its sender."""
+        ac = self.action_client
+        status = ac.last_status_msg
+        if not status:
+            return False
+        server = status._connection_header['callerid']
+        return (ac.pub_goal.impl.has_connection(server) and ac.pub_cancel.impl.has_connection(server)
+                and any(c.callerid_pub == server for c in ac.result_sub.impl.connections)
+                and any(c.callerid_pub == server for c in ac.feedback_sub.impl.connections))
 
     def send_goal(self, goal, done_cb=None, active_cb=None, feedback_cb=None):
         with self._sending:

@@ -17,7 +17,7 @@ goal, the log lines, a shutdown that cancels the goal and stops the robot), with
 Parameters (private): rest_time (2 s), locations_file ('' = the tutorial's table; see
 config/wall_locations.yaml for the format), max_goals (0 = forever), max_duration (0 = forever, s
 of ROS time), goal_timeout (300 s), seed (-1 = random), frame_id ('map'), base_frame
-('base_footprint'), server_timeout (60 s). With a limit it prints a summary and exits 0.
+('base_footprint'), server_timeout (60 s of wall time). With a limit it prints a summary and exits 0.
 
 Beyond the tutorial: move_base killed mid-goal (and respawned) is noticed, waited for and the goal
 sent again (pursue()), so a soak's count goes on instead of waiting out goal_timeout; a goal that
