@@ -116,9 +116,10 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       since_node = relativePose(nodes_.back().odom, odom);
     }
     // What lies farther than the newest node of the local map could see is not in that map: those
-    // returns (the far end of a corridor walls, coming into range as the robot drives on) would
-    // pull the match back towards where the map ends, and the map shrank along every corridor.
-    const double gate = reach - since_node.head<2>().norm() - params_.local_search_window;
+    // returns (the far end of a corridor's walls, coming into range as the robot drives on) pull
+    // the match back towards where the map ends. Never less than half the reach (a long
+    // linearUpdate with a short laser would leave nothing to match).
+    const double gate = std::max(0.5 * reach, reach - since_node.head<2>().norm() - params_.local_search_window);
     const Eigen::Vector2d laser = params_.matcher.laser_pose.head<2>();
     std::vector<Eigen::Vector2d> near;
     near.reserve(points->size());
@@ -243,8 +244,8 @@ void GraphSlam::rebuildLocalMapLocked() {
   const int n = static_cast<int>(nodes_.size());
   const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
   for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
-    // Walls as surfaces, not as the beams' hits (surfacePoints): else a scan tracked in this map
-    // is pulled back towards where the nodes saw from, and the map shrinks along every corridor.
+    // Walls as surfaces, not as the beams' hits (surfacePoints): hits thin out with range, so a
+    // scan tracked in a map of hits alone scores higher moved back towards where the nodes saw from.
     if (nodes_[k].scan) {
       appendMoved(surfacePoints(*nodes_[k].scan, params_.matcher.laser_pose, reach, params_.delta), nodes_[k].pose, reference);
     } else {
