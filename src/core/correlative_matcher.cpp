@@ -130,52 +130,55 @@ std::size_t LikelihoodGrid::bytes() const {
   return n;
 }
 
-std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
-                                         double voxel_m) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(scan.ranges_m.size());
-  std::unordered_set<uint64_t> seen;
+namespace {
+// One point per voxel_m square: the voxel's key, for a set of the voxels taken.
+uint64_t voxelKey(const Eigen::Vector2d& p, double voxel_m) {
+  const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
+  return (static_cast<uint64_t>(kx) << 32) ^ (static_cast<uint64_t>(ky) & 0xffffffffu);
+}
+
+// Calls f(i, r, p) for every beam i with a usable return r (finite, within [range_min,
+// min(max_range, range_max))), p its end point in the base frame.
+template <typename F>
+void forEachReturn(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m, F f) {
   const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     const double r = scan.ranges_m[i];
     if (!std::isfinite(r) || r <= 0.0 || r < scan.range_min_m || r >= limit) continue;
     const double a = laser_pose.z() + scan.beamAngle(i);
-    const Eigen::Vector2d p = laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-    if (voxel_m > 0.0) {
-      const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
-      const uint64_t key = (static_cast<uint64_t>(kx) << 32) ^ (static_cast<uint64_t>(ky) & 0xffffffffu);
-      if (!seen.insert(key).second) continue;
-    }
-    out.push_back(p);
+    f(i, r, Eigen::Vector2d(laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a))));
   }
+}
+}  // namespace
+
+std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
+                                         double voxel_m) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(scan.ranges_m.size());
+  std::unordered_set<uint64_t> seen;
+  forEachReturn(scan, laser_pose, max_range_m, [&](std::size_t, double, const Eigen::Vector2d& p) {
+    if (voxel_m <= 0.0 || seen.insert(voxelKey(p, voxel_m)).second) out.push_back(p);
+  });
   return out;
 }
 
 std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
                                            double voxel_m) {
-  std::vector<Eigen::Vector2d> out;
   if (!(voxel_m > 0.0)) return matchPoints(scan, laser_pose, max_range_m, voxel_m);
+  std::vector<Eigen::Vector2d> out;
   out.reserve(2 * scan.ranges_m.size());
   std::unordered_set<uint64_t> seen;
   auto add = [&](const Eigen::Vector2d& p) {
-    const int64_t kx = static_cast<int64_t>(std::floor(p.x() / voxel_m)), ky = static_cast<int64_t>(std::floor(p.y() / voxel_m));
-    const uint64_t key = (static_cast<uint64_t>(kx) << 32) ^ (static_cast<uint64_t>(ky) & 0xffffffffu);
-    if (seen.insert(key).second) out.push_back(p);
+    if (seen.insert(voxelKey(p, voxel_m)).second) out.push_back(p);
   };
-  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
   const double step = std::abs(scan.angle_increment_rad);
+  std::size_t last_i = 0;
   bool have_last = false;
   Eigen::Vector2d last;
   double last_r = 0.0;
-  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
-    const double r = scan.ranges_m[i];
-    if (!std::isfinite(r) || r <= 0.0 || r < scan.range_min_m || r >= limit) {
-      have_last = false;  // only neighbouring beams make a surface
-      continue;
-    }
-    const double a = laser_pose.z() + scan.beamAngle(i);
-    const Eigen::Vector2d p = laser_pose.head<2>() + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-    if (have_last) {
+  forEachReturn(scan, laser_pose, max_range_m, [&](std::size_t i, double r, const Eigen::Vector2d& p) {
+    // only neighbouring beams make a surface
+    if (have_last && i == last_i + 1) {
       const double gap = (p - last).norm();
       const double max_gap = std::min(0.3, std::max(2.0 * voxel_m, 4.0 * std::max(r, last_r) * step));
       if (gap > voxel_m && gap <= max_gap) {
@@ -186,8 +189,9 @@ std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::V
     add(p);
     last = p;
     last_r = r;
+    last_i = i;
     have_last = true;
-  }
+  });
   return out;
 }
 
