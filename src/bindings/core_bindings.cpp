@@ -436,6 +436,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("local_min_score", &GraphSlamParams::local_min_score)
       .def_readwrite("local_prior_margin", &GraphSlamParams::local_prior_margin)
       .def_readwrite("local_prior_weight", &GraphSlamParams::local_prior_weight)
+      .def_readwrite("local_visible_only", &GraphSlamParams::local_visible_only)
       .def_readwrite("submap_nodes", &GraphSlamParams::submap_nodes)
       .def_readwrite("loop_search_radius", &GraphSlamParams::loop_search_radius)
       .def_readwrite("loop_search_growth", &GraphSlamParams::loop_search_growth)

@@ -195,6 +195,61 @@ std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::V
   return out;
 }
 
+void Visibility::add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, const Eigen::Vector3d& pose,
+                     double max_range_m) {
+  View v;
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  v.origin = pose.head<2>() + Eigen::Vector2d(c * laser_pose.x() - s * laser_pose.y(), s * laser_pose.x() + c * laser_pose.y());
+  v.first_angle = pose.z() + laser_pose.z() + scan.angle_min_rad;
+  v.increment = scan.angle_increment_rad;
+  const double step = std::abs(v.increment);
+  v.all_round = step * static_cast<double>(scan.ranges_m.size()) >= 2.0 * M_PI - 0.5 * step;
+  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
+  v.reach.reserve(scan.ranges_m.size());
+  for (float r : scan.ranges_m) {
+    // No return (inf, or at the sensor's maximum: REP 117) means free out to the maximum range;
+    // NaN, -inf and returns below range_min say nothing.
+    if (std::isnan(r) || r < scan.range_min_m || r <= 0.0f) {
+      v.reach.push_back(0.0f);
+    } else {
+      v.reach.push_back(static_cast<float>(std::min<double>(r, limit)));
+    }
+  }
+  if (step > 0.0 && !v.reach.empty()) views_.push_back(std::move(v));
+}
+
+bool Visibility::seen(const Eigen::Vector2d& p, double tolerance_m) const {
+  for (const View& v : views_) {
+    const Eigen::Vector2d d = p - v.origin;
+    const double rho = d.norm();
+    const int n = static_cast<int>(v.reach.size());
+    // bearing relative to beam 0, in [0, 2 pi) along the direction the beams advance
+    double rel = std::atan2(d.y(), d.x()) - v.first_angle;
+    if (v.increment < 0.0) rel = -rel;
+    rel -= 2.0 * M_PI * std::floor(rel / (2.0 * M_PI));
+    // The nearest beam: at a depth edge (a door jamb before a room) the farther of the two beams
+    // either side would let through what lies just behind the jamb, which that scan did not see.
+    int b = static_cast<int>(std::lround(rel / std::abs(v.increment)));
+    if (b >= n) {
+      if (!v.all_round) continue;  // outside the field of view
+      b = b == n ? 0 : n - 1;
+    }
+    if (rho <= v.reach[b] + tolerance_m) return true;
+  }
+  return false;
+}
+
+std::vector<Eigen::Vector2d> Visibility::seenOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
+                                               double tolerance_m) const {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(points.size());
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  for (const auto& p : points) {
+    if (seen({pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y()}, tolerance_m)) out.push_back(p);
+  }
+  return out;
+}
+
 namespace {
 struct Candidate {
   int rotation;

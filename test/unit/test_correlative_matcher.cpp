@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -163,4 +164,48 @@ TEST(CorrelativeMatcher, TheInterpolatedScorePeaksOnAWallThatLiesOnACellBorder) 
   EXPECT_GT(on, grid.interpolated({1.0, 0.985}) + 0.005);
   EXPECT_GT(on, grid.interpolated({1.0, 1.015}) + 0.005);
   EXPECT_NEAR(grid.interpolated({1.0, 0.985}), grid.interpolated({1.0, 1.015}), 1e-3);
+}
+
+TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
+  // The base at the origin facing +y, its laser turned to face +x; a wall 2 m long across x = 3.
+  World2D w;
+  w.addBox({3.05, 0}, 0, 0.1, 2.0);
+  std::mt19937 rng(3);
+  const Eigen::Vector3d pose(0.0, 0.0, M_PI / 2), laser(0.0, 0.0, -M_PI / 2);
+  LaserScan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = M_PI / 180;
+  s.range_min_m = 0.1;
+  s.range_max_m = 6.0;
+  s.ranges_m.resize(360);
+  w.castScan(composePose(pose, laser), s.angle_min_rad, s.angle_increment_rad, 360, 0.1, 6.0, 0.0, 0.0, rng,
+             s.ranges_m.data());
+  s.ranges_m[90] = std::numeric_limits<float>::quiet_NaN();  // towards -y: says nothing
+  Visibility v;
+  EXPECT_TRUE(v.empty());
+  v.add(s, laser, pose, 5.0);
+  ASSERT_FALSE(v.empty());
+  EXPECT_TRUE(v.seen({2.0, 0.0}, 0.05)) << "in front of the wall";
+  EXPECT_TRUE(v.seen({3.03, 0.5}, 0.05)) << "on the wall";
+  EXPECT_FALSE(v.seen({3.5, 0.0}, 0.05)) << "behind the wall";
+  EXPECT_TRUE(v.seen({3.5, 0.0}, 0.6)) << "within the tolerance";
+  EXPECT_TRUE(v.seen({0.0, 4.9}, 0.05)) << "no return: free out to the maximum range given";
+  EXPECT_FALSE(v.seen({0.0, 5.5}, 0.05)) << "beyond the range given (5 m, not the sensor's 6 m)";
+  EXPECT_FALSE(v.seen({0.0, -1.0}, 0.05)) << "the beam with no usable reading";
+  EXPECT_TRUE(v.seen({-1.0, 0.007}, 0.05)) << "past the last beam, next to the first: the scan sees all round";
+  // Half the circle, ahead of the laser: nothing behind it was seen.
+  LaserScan half = s;
+  half.angle_min_rad = -M_PI / 2;
+  half.ranges_m.assign(s.ranges_m.begin() + 90, s.ranges_m.begin() + 270);
+  Visibility front;
+  front.add(half, laser, pose, 5.0);
+  EXPECT_TRUE(front.seen({2.0, 0.0}, 0.05));
+  EXPECT_FALSE(front.seen({-1.0, 0.0}, 0.05)) << "behind a 180 degree laser";
+  EXPECT_FALSE(front.seen({-1.0, 0.007}, 0.05)) << "behind a 180 degree laser";
+  // Points in the frame of a base at (0.5, 0) facing +x: (1.5, 0) in front, (3, 0) on the wall,
+  // (3.5, 0.3) behind it.
+  const std::vector<Eigen::Vector2d> points{{1.0, 0.0}, {2.5, 0.0}, {3.0, 0.3}};
+  const auto kept = front.seenOf(points, {0.5, 0.0, 0.0}, 0.05);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_DOUBLE_EQ(kept[1].x(), 2.5);
 }

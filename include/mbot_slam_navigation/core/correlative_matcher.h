@@ -91,6 +91,41 @@ std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vec
 std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
                                            double voxel_m);
 
+/// What a set of scans could see, for leaving out of a match the returns that the reference scans
+/// could not have seen: a point counts as seen when some scan's beam nearest its bearing reached
+/// at least that far, within a tolerance; a beam without a return reached its maximum range. A
+/// scan tracked while the robot drives on sees, besides what the map holds, what came into view
+/// (behind door jambs and corners, round the robot's new position); those returns lie next to the
+/// map's edges and score higher the farther back the scan is put. Measured on an office run's
+/// scans with ground truth, pairs of scans 2 m apart, one scan matched in a map of the other:
+/// with every return the scan is put back by 1.3% of the distance (mean; 2.1 cm median); with the
+/// seen returns only (a cell of tolerance), 0.2% forward. With the farther of the two beams either
+/// side instead of the nearest, 0.6% back; with two cells of tolerance, 0.5% back.
+/// Frames: every pose in the reference frame, as the grid's.
+class Visibility {
+ public:
+  /// Adds what `scan` saw from `pose` (the base in the reference frame), its beams from
+  /// `laser_pose` in the base frame, reaching at most `max_range_m`.
+  void add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, const Eigen::Vector3d& pose, double max_range_m);
+  /// Whether some added scan saw `p` (reference frame), with `tolerance_m` beyond its returns.
+  bool seen(const Eigen::Vector2d& p, double tolerance_m) const;
+  /// The `points` (base frame) that some added scan saw when the base is at `pose`.
+  std::vector<Eigen::Vector2d> seenOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
+                                      double tolerance_m) const;
+  bool empty() const { return views_.empty(); }
+  void clear() { views_.clear(); }
+
+ private:
+  struct View {
+    Eigen::Vector2d origin;    // the laser in the reference frame
+    double first_angle = 0.0;  // of beam 0, reference frame [rad]
+    double increment = 0.0;    // [rad]
+    bool all_round = false;    // the last beam is next to the first
+    std::vector<float> reach;  // [m] per beam: its return, its maximum range, or 0 (no usable reading)
+  };
+  std::vector<View> views_;
+};
+
 /// The best pose of `points` (base frame) in `window` around `init`, if one scores above
 /// `min_score`. Candidates within `exclude_radius_m` / `exclude_angle_rad` of `exclude` (when
 /// `exclude` is given) are skipped: used to look for a second, different good match.

@@ -88,6 +88,10 @@ struct GraphSlamParams {
   double local_prior_margin = 0.03;
   /// [1/m^2] score lost per square metre away from the prediction in that climb (`~local_prior_weight`).
   double local_prior_weight = 5.0;
+  /// Track a scan only with the returns that the local map's scans could have seen (Visibility in
+  /// correlative_matcher.h; `~local_visible_only`): the others, what came into view as the robot
+  /// drove on, pull the match back, and an office run's map came out 1% short.
+  bool local_visible_only = true;
   int submap_nodes = 10;            ///< nodes per loop-closure submap (`~submap_nodes`)
   double loop_search_radius = 2.0;  ///< [m] search radius right after a closure (`~loop_search_radius`)
   double loop_search_growth = 0.05; ///< [m per m travelled] radius growth (`~loop_search_growth`)
@@ -181,6 +185,7 @@ class GraphSlam : public SlamBackend {
   struct Submap {
     int first, last;        // node indices [first, last]; first is the anchor
     std::shared_ptr<const LikelihoodGrid> grid;  // in the anchor's frame
+    std::shared_ptr<const Visibility> seen;      // what its nodes' scans saw, anchor frame (null: not kept)
   };
 
   Eigen::Vector3d matchLocally(const Eigen::Vector3d& predicted, const std::vector<Eigen::Vector2d>& points);
@@ -234,6 +239,7 @@ class GraphSlam : public SlamBackend {
   // Scan tracking (processScan's thread): the local map, the last node's pose when it was built
   // (its frame), and the latest scan's matched pose in that frame with its odometry.
   std::unique_ptr<LikelihoodGrid> local_map_;
+  Visibility local_seen_;  // what the local map's scans saw, in its frame
   Eigen::Vector3d local_anchor_ = Eigen::Vector3d::Zero(), track_pose_ = Eigen::Vector3d::Zero(),
                   track_odom_ = Eigen::Vector3d::Zero();
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0, travelled_ = 0.0;

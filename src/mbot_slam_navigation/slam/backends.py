@@ -27,7 +27,7 @@ GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
 GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
     'match_max_range': 30.0, 'match_sigma': 0.075, 'local_map_nodes': 20, 'local_search_window': 0.15,
     'local_search_angle': 0.15, 'local_min_score': 0.25, 'local_prior_margin': 0.03,
-    'local_prior_weight': 5.0, 'submap_nodes': 10, 'loop_search_radius': 2.0,
+    'local_prior_weight': 5.0, 'local_visible_only': 1, 'submap_nodes': 10, 'loop_search_radius': 2.0,
     'loop_search_growth': 0.05, 'loop_search_max_radius': 6.0, 'loop_search_angle': 0.35,
     'loop_min_response': 0.55, 'loop_ambiguity': 0.9, 'loop_candidates': 3, 'redundant_distance': 0.3,
     'redundant_angle': 0.5, 'loop_solve_chi2': 7.8,
@@ -36,6 +36,7 @@ BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
 INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'local_map_nodes', 'submap_nodes',
               'loop_candidates'}
+BOOL_PARAMS = {'local_visible_only'}
 
 
 def defaults_of(backend: str) -> Dict[str, float]:
@@ -93,7 +94,7 @@ def make_graph_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), b
     p.matcher = _matcher(v, laser_pose)
     for key in GRAPH_DEFAULTS:
         if key not in COMMON_DEFAULTS:
-            setattr(p, key, int(v[key]) if key in INT_PARAMS else float(v[key]))
+            setattr(p, key, bool(v[key]) if key in BOOL_PARAMS else int(v[key]) if key in INT_PARAMS else float(v[key]))
     p.background = background
     p.validate()
     return p
