@@ -16,6 +16,9 @@ import time
 from typing import Dict, List, Optional
 
 
+EXPLORERS = ('explore', 'explore_team')  # node names whose report run() waits for
+
+
 def report_dir_of(launch_args: List[str]) -> Optional[str]:
     for a in launch_args:
         if a.startswith('report_dir:='):
@@ -109,12 +112,24 @@ def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Option
     # A SIGTERM to this process (a bench killed, a CI timeout) must not leave the launch running.
     previous = signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     t0 = time.monotonic()
+    explorers: set = set()  # explorer nodes seen running
+    gone_since = None
     try:
         while not os.path.exists(report):
             if proc.poll() is not None:
                 print('run_exploration: roslaunch ended (exit %d) before the explorer wrote %s' % (proc.returncode,
                                                                                                   report), flush=True)
                 return None
+            # An explorer that died (not required="true": see above) leaves the launch running with
+            # no one to write the report; do not wait out the wall-clock limit for it.
+            running = {n for n in node_pids(proc.pid) if n.rsplit('/', 1)[-1] in EXPLORERS}
+            explorers |= running
+            if explorers and not running:
+                gone_since = gone_since or time.monotonic()
+                if time.monotonic() - gone_since > 5.0:
+                    print('run_exploration: %s ended without writing %s (see its log above); stopping the launch'
+                          % (', '.join(sorted(explorers)), report), flush=True)
+                    return None
             if time.monotonic() - t0 > wall_timeout:
                 print('run_exploration: no report after %.0f s of wall time; stopping the launch' % wall_timeout,
                       flush=True)

@@ -198,11 +198,11 @@ def write_figures(report_dir: str, figures: Dict) -> None:
 
 def team_figures(reports: Dict[str, Dict]) -> Dict:
     """The team's figures from each robot's explorer report (by robot name): outcome `complete` only
-    if every robot's is, else the first of stuck, timeout, not_started found; the exploration time is
+    if every robot's is, else the first of error, stuck, timeout, not_started found; the exploration time is
     the last robot's; distances, goals and collisions per robot and summed."""
     outcomes = [r.get('outcome', 'not_started') for r in reports.values()]
     outcome = 'complete' if outcomes and all(o == 'complete' for o in outcomes) else next(
-        (o for o in ('stuck', 'timeout', 'not_started') if o in outcomes), 'not_started')
+        (o for o in ('error', 'stuck', 'timeout', 'not_started') if o in outcomes), 'not_started')
     per_robot = {name: {k: r.get(k) for k in ('outcome', 'exploration_time_s', 'distance_m', 'goals_sent',
                                               'goals_failed', 'collisions', 'why') if k in r or k != 'why'}
                  for name, r in sorted(reports.items())}

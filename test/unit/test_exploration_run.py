@@ -14,7 +14,8 @@ from mbot_slam_navigation import exploration_run
 FAKE_ROSLAUNCH = r'''#!/usr/bin/env python3
 import json, os, signal, subprocess, sys, time
 args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
-node = subprocess.Popen([sys.executable, '-c', 'import time\nt=time.time()\nwhile time.time()-t<0.3: pass\ntime.sleep(60)',
+life = 1 if args.get('mode') == 'explorer_dies' else 60
+node = subprocess.Popen([sys.executable, '-c', 'import time\nt=time.time()\nwhile time.time()-t<0.3: pass\ntime.sleep(%d)' % life,
                          '__name:=explore'])
 def bye(*_):
     node.terminate(); node.wait()
@@ -24,7 +25,7 @@ signal.signal(signal.SIGINT, bye)
 if args.get('mode') == 'die':
     sys.exit(3)
 time.sleep(1.0)
-if args.get('mode') != 'hang':
+if args.get('mode') not in ('hang', 'explorer_dies'):
     tmp = os.path.join(args['report_dir'], '.r.tmp')
     json.dump({'outcome': args.get('outcome', 'complete'), 'exploration_time_s': 12.0, 'wall_time_s': 1.0,
                'collisions': 0, 'given_up': []}, open(tmp, 'w'))
@@ -75,6 +76,18 @@ def test_no_report_ends_with_a_message_and_status_2(fake_launch, capsys):
     assert e.value.code == 2
     assert 'no report after 3 s of wall time' in capsys.readouterr().out
     assert (fake_launch / 'stopped').exists()  # the hanging launch was stopped, not left running
+
+
+def test_an_explorer_that_dies_without_a_report_ends_the_run_at_once(fake_launch, capsys):
+    # the explorer died (an exception) and roslaunch ran on: not an hour's wait for the report
+    t0 = time.monotonic()
+    with pytest.raises(SystemExit) as e:
+        exploration_run.main(['--wall-timeout', '120', 'pkg', 'x.launch', 'report_dir:=%s' % fake_launch,
+                              'mode:=explorer_dies'])
+    assert e.value.code == 2
+    assert time.monotonic() - t0 < 30.0
+    assert 'explore ended without writing' in capsys.readouterr().out
+    assert (fake_launch / 'stopped').exists()
 
 
 def test_report_dir_is_required():

@@ -316,6 +316,10 @@ def test_the_tour_finishes_the_dead_end_side_before_crossing_to_the_other():
     walled = passable.copy()
     walled[5:13, 119:121] = 0
     assert tour_order([west] + east, walled, grid)[0].goal == (4.0, 0.5)
+    # a goal off the passable grid (found on a costmap larger than this one): ranked, not a crash
+    # (the explorer died with an IndexError here on the large floor)
+    beyond = _frontier_at(30.0, 0.5, 25.0, size_m=1.0)
+    assert [f.goal for f in tour_order([west, beyond] + east, passable, grid)][-1] == (30.0, 0.5)
     # one frontier, or tours switched off: unchanged
     assert tour_order([west], passable, grid) == [west]
     assert tour_order(greedy, passable, grid, size=0) == greedy

@@ -12,8 +12,10 @@ sent again. Every run ends, with an outcome:
 - `stuck`: goals fail, the robot has not moved for progress_timeout and move_base cannot move it;
   the explorer then backs it out along its own recent path by cmd_vel, checking the laser (a
   warning says so); if that fails twice, or the robot is boxed in with no path of its own, the
-  robot is stopped and the exploration ends.
-Then the robot returns to its start pose (not when stuck; within return_timeout), the report is
+  robot is stopped and the exploration ends;
+- `error`: an exception inside the explorer (a bug): logged with its traceback, the robot stopped,
+  the report written with the error, rather than a node that dies and leaves the launch running.
+Then the robot returns to its start pose (not when stuck or on error; within return_timeout), the report is
 written to ~report_dir if set (mbot_slam_navigation.explore_report), and `explore/complete`
 (std_msgs/Bool, latched) turns true.
 
@@ -47,6 +49,7 @@ for a robot when no frontier is left to anyone.
 import math
 import os
 import time
+import traceback
 from typing import List, Optional, Tuple
 
 import numpy as np
@@ -148,6 +151,7 @@ class Explore:
         self.map: Optional[Grid] = None
         self.map_with_stamp: Tuple[Optional[Grid], rospy.Time] = (None, rospy.Time(0))
         self.costmap: Optional[Grid] = None
+        self.error = ''  # an internal error that ended the exploration (outcome 'error')
         self.collisions = 0
         self.start_time: Optional[rospy.Time] = None  # set when exploring starts
         self.path: List[Tuple[float, float]] = []
@@ -329,7 +333,13 @@ class Explore:
         self.start_time = rospy.Time.now()
         wall0 = time.monotonic()
         rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
-        outcome = self.explore(wall0)
+        try:
+            outcome = self.explore(wall0)
+        except Exception as e:  # a bug of ours: stop the robot and report it rather than die silently
+            rospy.logerr('explore: internal error, the exploration ends here: %s\n%s' % (e, traceback.format_exc()))
+            self.error = '%s: %s' % (type(e).__name__, e)
+            self.cmd_pub.publish(Twist())
+            outcome = 'error'
         if outcome is not None:
             self.finish(outcome, start, wall0)
 
@@ -372,7 +382,10 @@ class Explore:
             stats = {}
             unreachable: List[GivenUp] = []
             m, m_stamp = self.map_with_stamp
-            ranked = rank_frontiers(m, self.costmap, pose[:2], self.min_frontier_size, self.potential_scale,
+            # One costmap for the whole cycle: the callback may replace it with a larger one (the
+            # SLAM map grew) between two uses, and a goal found on one is no cell of the other.
+            costmap = self.costmap
+            ranked = rank_frontiers(m, costmap, pose[:2], self.min_frontier_size, self.potential_scale,
                                     self.gain_scale, self.state.avoid(now), self.state.blacklist_radius,
                                     min_unknown_area=self.min_unknown_area, stats=stats,
                                     avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
@@ -389,7 +402,7 @@ class Explore:
                     self.move_base.cancel_goal()
                 frontiers, claimed = share_out(frontiers, mates, self.claim_radius, self.potential_scale)
             elif self.tour_frontiers >= 2 and 'passable' in stats:
-                frontiers = tour_order(frontiers, stats['passable'], self.costmap, self.potential_scale,
+                frontiers = tour_order(frontiers, stats['passable'], costmap, self.potential_scale,
                                        self.tour_frontiers)
             self.publish_markers(frontiers)
             self.plateau.update(now, explore_report.known_area(m), bool(frontiers) or self.state.goal is not None)
@@ -542,7 +555,9 @@ class Explore:
         self.move_base.cancel_goal()
         if outcome == 'complete':
             rospy.loginfo('explore: no reachable frontier left after %.0f s; exploration complete', t_explored)
-        if outcome == 'stuck':
+        if outcome == 'error':
+            pass  # no return: whatever failed may fail again
+        elif outcome == 'stuck':
             self.cmd_pub.publish(Twist())
             rospy.logerr('explore: the robot is stuck at %s; the exploration ends here' % (self.robot_pose(),))
         elif self.return_to_start:
@@ -568,6 +583,8 @@ class Explore:
             'longest_plateau_at_s': round(self.plateau.longest_at, 1),
             'given_up': [g.as_dict() for g in self.given_up],
         }
+        if self.error:
+            figures['error'] = self.error
         if self.report_dir and self.map is not None:
             world, rooms = None, ()
             if self.world_name and os.path.isfile(self.world_name):

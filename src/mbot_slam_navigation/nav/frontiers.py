@@ -218,12 +218,14 @@ def tour_order(frontiers: List[Frontier], passable: np.ndarray, costmap: Grid, p
     for f in head:
         r, c = costmap.cell_of(f.goal[0], f.goal[1])
         cells.append((int(r) // b, int(c) // b))
+    inside = [0 <= r < coarse.shape[0] and 0 <= c < coarse.shape[1] for r, c in cells]
     step = b * costmap.resolution
     d = np.zeros((k, k))
     for i in range(k - 1):
-        lengths = _core._path_lengths(coarse, cells[i][1], cells[i][0])
+        lengths = _core._path_lengths(coarse, cells[i][1], cells[i][0]) if inside[i] else None
         for j in range(i + 1, k):
-            v = float(lengths[cells[j]]) * step
+            # a goal off this grid (passable and costmap of different cycles): no path known
+            v = float(lengths[cells[j]]) * step if lengths is not None and inside[j] else -1.0
             # not connected on the coarse grid (a goal in a block of its own): via the robot
             d[i, j] = d[j, i] = v if v >= 0 else head[i].path_m + head[j].path_m
     # rest[s]: the shortest path that visits every goal and ends (by symmetry: begins) at s
