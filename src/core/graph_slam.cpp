@@ -267,11 +267,11 @@ void GraphSlam::rebuildLocalMapLocked() {
       appendMoved(*nodes_[k].points, nodes_[k].pose, reference);
     }
   }
-  // Under the lock with the node that it ends with, so that currentPose() never sees a new node
-  // with the old anchor.
   // A node whose scan was freed leaves its points in the map but nothing to say what it saw:
   // then every return counts.
   if (!all_scans) local_seen_.clear();
+  // Under the lock with the node that it ends with, so that currentPose() never sees a new node
+  // with the old anchor.
   local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, params_.match_sigma);
   local_anchor_ = track_pose_ = nodes_.back().pose;
   track_odom_ = nodes_.back().odom;

@@ -172,14 +172,7 @@ TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
   w.addBox({3.05, 0}, 0, 0.1, 2.0);
   std::mt19937 rng(3);
   const Eigen::Vector3d pose(0.0, 0.0, M_PI / 2), laser(0.0, 0.0, -M_PI / 2);
-  LaserScan s;
-  s.angle_min_rad = -M_PI;
-  s.angle_increment_rad = M_PI / 180;
-  s.range_min_m = 0.1;
-  s.range_max_m = 6.0;
-  s.ranges_m.resize(360);
-  w.castScan(composePose(pose, laser), s.angle_min_rad, s.angle_increment_rad, 360, 0.1, 6.0, 0.0, 0.0, rng,
-             s.ranges_m.data());
+  LaserScan s = scanAt(w, composePose(pose, laser), rng, 0.0);  // 360 beams from -pi, 12 m
   s.ranges_m[90] = std::numeric_limits<float>::quiet_NaN();  // towards -y: says nothing
   Visibility v;
   EXPECT_TRUE(v.empty());
@@ -190,7 +183,7 @@ TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
   EXPECT_FALSE(v.seen({3.5, 0.0}, 0.05)) << "behind the wall";
   EXPECT_TRUE(v.seen({3.5, 0.0}, 0.6)) << "within the tolerance";
   EXPECT_TRUE(v.seen({0.0, 4.9}, 0.05)) << "no return: free out to the maximum range given";
-  EXPECT_FALSE(v.seen({0.0, 5.5}, 0.05)) << "beyond the range given (5 m, not the sensor's 6 m)";
+  EXPECT_FALSE(v.seen({0.0, 5.5}, 0.05)) << "beyond the range given (5 m, not the sensor's 12 m)";
   EXPECT_FALSE(v.seen({0.0, -1.0}, 0.05)) << "the beam with no usable reading";
   EXPECT_TRUE(v.seen({-1.0, 0.007}, 0.05)) << "past the last beam, next to the first: the scan sees all round";
   // Half the circle, ahead of the laser: nothing behind it was seen.
