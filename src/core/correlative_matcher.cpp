@@ -141,7 +141,7 @@ uint64_t voxelKey(const Eigen::Vector2d& p, double voxel_m) {
 // min(max_range, range_max))), p its end point in the base frame.
 template <typename F>
 void forEachReturn(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m, F f) {
-  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
+  const double limit = scan.usableRange(max_range_m);
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     const double r = scan.ranges_m[i];
     if (!std::isfinite(r) || r <= 0.0 || r < scan.range_min_m || r >= limit) continue;
@@ -198,13 +198,12 @@ std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::V
 void Visibility::add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, const Eigen::Vector3d& pose,
                      double max_range_m) {
   View v;
-  const double c = std::cos(pose.z()), s = std::sin(pose.z());
-  v.origin = pose.head<2>() + Eigen::Vector2d(c * laser_pose.x() - s * laser_pose.y(), s * laser_pose.x() + c * laser_pose.y());
-  v.first_angle = pose.z() + laser_pose.z() + scan.angle_min_rad;
+  const Eigen::Vector3d laser = composePose(pose, laser_pose);
+  v.origin = laser.head<2>();
+  v.first_angle = laser.z() + scan.angle_min_rad;
   v.increment = scan.angle_increment_rad;
-  const double step = std::abs(v.increment);
-  v.all_round = step * static_cast<double>(scan.ranges_m.size()) >= 2.0 * M_PI - 0.5 * step;
-  const double limit = std::min(max_range_m, scan.range_max_m > 0.0 ? scan.range_max_m : max_range_m);
+  v.all_round = scan.seesAllRound();
+  const double limit = scan.usableRange(max_range_m);
   v.reach.reserve(scan.ranges_m.size());
   for (float r : scan.ranges_m) {
     // No return (inf, or at the sensor's maximum: REP 117) means free out to the maximum range;
@@ -215,7 +214,7 @@ void Visibility::add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, c
       v.reach.push_back(static_cast<float>(std::min<double>(r, limit)));
     }
   }
-  if (step > 0.0 && !v.reach.empty()) views_.push_back(std::move(v));
+  if (v.increment != 0.0 && !v.reach.empty()) views_.push_back(std::move(v));
 }
 
 bool Visibility::seen(const Eigen::Vector2d& p, double tolerance_m) const {

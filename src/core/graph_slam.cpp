@@ -103,7 +103,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
   }
   const bool due = first || linear_distance_ > params_.linear_update || angular_distance_ > params_.angular_update ||
                    (params_.temporal_update >= 0.0 && time_s - last_update_time_ > params_.temporal_update);
-  const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
+  const double reach = matchReach();
   auto points = std::make_shared<const std::vector<Eigen::Vector2d>>(
       matchPoints(scan, params_.matcher.laser_pose, reach, params_.delta));
   Eigen::Vector3d tracked = odom;
@@ -163,7 +163,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       pose = composePose(nodes_.back().pose, z);
       edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
     }
-    const bool redundant = !first && redundantLocked(pose, seesAllRound(scan));
+    const bool redundant = !first && redundantLocked(pose, scan.seesAllRound());
     nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points, redundant});
     if (redundant) {
       redundant_.push_back(index);
@@ -182,11 +182,6 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
     pending_.clear();
   }
   return true;
-}
-
-bool GraphSlam::seesAllRound(const LaserScan& scan) {
-  const double step = std::abs(scan.angle_increment_rad);
-  return step * static_cast<double>(scan.ranges_m.size()) >= 2.0 * M_PI - 0.5 * step;
 }
 
 bool GraphSlam::redundantLocked(const Eigen::Vector3d& pose, bool all_round) const {
@@ -250,21 +245,18 @@ void GraphSlam::mergeLocked(int k) {
 void GraphSlam::rebuildLocalMapLocked() {
   std::vector<Eigen::Vector2d> reference;
   const int n = static_cast<int>(nodes_.size());
-  const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
+  const double reach = matchReach();
   local_seen_.clear();
   bool all_scans = true;
   for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
-    if (nodes_[k].scan) {
-      local_seen_.add(*nodes_[k].scan, params_.matcher.laser_pose, nodes_[k].pose, reach);
-    } else {
-      all_scans = false;
-    }
     // Walls as surfaces, not as the beams' hits (surfacePoints): hits thin out with range, so a
     // scan tracked in a map of hits alone scores higher moved back towards where the nodes saw from.
     if (nodes_[k].scan) {
       appendMoved(surfacePoints(*nodes_[k].scan, params_.matcher.laser_pose, reach, params_.delta), nodes_[k].pose, reference);
+      local_seen_.add(*nodes_[k].scan, params_.matcher.laser_pose, nodes_[k].pose, reach);
     } else {
       appendMoved(*nodes_[k].points, nodes_[k].pose, reference);
+      all_scans = false;
     }
   }
   // A node whose scan was freed leaves its points in the map but nothing to say what it saw:
@@ -357,7 +349,7 @@ void GraphSlam::buildSubmap(int first, int last) {
     }
     nodes_[first].anchor = true;  // the submap's frame: never merged
     const Eigen::Vector3d& anchor = nodes_[first].pose;
-    const double reach = std::min(params_.match_max_range, params_.matcher.max_urange);
+    const double reach = matchReach();
     if (params_.local_visible_only) seen = std::make_shared<Visibility>();
     for (int k = first; k <= last; ++k) {
       const Eigen::Vector3d pose = relativePose(anchor, nodes_[k].pose);
@@ -442,9 +434,10 @@ bool GraphSlam::searchClosures(int n) {
         const double tol = params_.delta;
         const std::vector<Eigen::Vector2d> at_found = c.seen->seenOf(*points, refined, tol);
         const MatchResult local =
-            matchBranchAndBound(*c.grid, *points, init, {std::min(radius, 0.3), params_.loop_search_angle}, 0.0);
-        if (2 * at_found.size() >= points->size() && local.found &&
-            (local.pose.head<2>() - refined.head<2>()).norm() > 0.3) {
+            2 * at_found.size() >= points->size()
+                ? matchBranchAndBound(*c.grid, *points, init, {std::min(radius, 0.3), params_.loop_search_angle}, 0.0)
+                : MatchResult{};
+        if (local.found && (local.pose.head<2>() - refined.head<2>()).norm() > 0.3) {
           const std::vector<Eigen::Vector2d> at_local = c.seen->seenOf(*points, local.pose, tol);
           if (2 * at_local.size() >= points->size()) {
             double found_score = 0.0, local_score = 0.0;

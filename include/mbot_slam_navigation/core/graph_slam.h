@@ -45,6 +45,7 @@
 // Frames and units: as slam_backend.h.
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <list>
@@ -199,8 +200,8 @@ class GraphSlam : public SlamBackend {
   /// redundant_distance, and within redundant_angle of its heading unless the laser sees
   /// `all_round` (mutex_ held).
   bool redundantLocked(const Eigen::Vector3d& pose, bool all_round) const;
-  /// Whether the scan's beams cover the full circle.
-  static bool seesAllRound(const LaserScan& scan);
+  /// [m] returns farther than this are not matched: match_max_range, or maxUrange if shorter.
+  double matchReach() const { return std::min(params_.match_max_range, params_.matcher.max_urange); }
   /// Frees the match points of nodes that neither the local map nor a submap still needs, and the
   /// scans of such nodes that are redundant, which then leave the optimization (mutex_ held).
   void trimLocked();

@@ -1,6 +1,8 @@
 // A planar laser scan without ROS types: the fields of sensor_msgs/LaserScan the core needs.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace mbot {
@@ -17,6 +19,16 @@ struct LaserScan {
 
   /// Angle of beam i in the sensor frame [rad].
   double beamAngle(std::size_t i) const { return angle_min_rad + static_cast<double>(i) * angle_increment_rad; }
+  /// Whether the beams cover the full circle (the last one next to the first).
+  bool seesAllRound() const {
+    const double step = std::abs(angle_increment_rad);
+    return step * static_cast<double>(ranges_m.size()) >= 2.0 * M_PI - 0.5 * step;
+  }
+  /// [m] the farthest range used of this scan when a user asks for at most `max_range_m`: the
+  /// smaller of the two (range_max unset: `max_range_m`).
+  double usableRange(double max_range_m) const {
+    return std::min(max_range_m, range_max_m > 0.0 ? range_max_m : max_range_m);
+  }
 };
 
 }  // namespace core
