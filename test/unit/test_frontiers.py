@@ -105,7 +105,33 @@ def test_blacklisted_places_are_avoided():
     m = room(door=(1.0, 2.0))
     c = costmap_of(m)
     f = rank_frontiers(m, c, (2.0, 2.0))
-    assert rank_frontiers(m, c, (2.0, 2.0), avoid=[f[0].goal], avoid_radius=1.5) == []
+    dropped = []
+    assert rank_frontiers(m, c, (2.0, 2.0), avoid=[f[0].goal], avoid_radius=1.5, unreachable=dropped) == []
+    # not silently: the report says which frontier is left out, and why
+    assert len(dropped) == 1 and dropped[0].x == pytest.approx(5.0, abs=0.1) and dropped[0].size_m >= 0.9
+    assert 'farther than 1.5 m from places visited or given up' in dropped[0].why
+
+
+def test_places_reached_are_left_out_while_other_frontiers_remain_but_not_for_good():
+    s = ExploreState(blacklist_timeout=60.0, max_tries=2)
+    s.choose(0.0, [frontier_at(2.0, 2.0)], (0.0, 0.0))
+    s.reached(10.0)                        # its frontier vanished on the way
+    s.choose(11.0, [frontier_at(5.0, 5.0)], (2.0, 2.0))
+    s.fail(20.0)
+    s.choose(90.0, [frontier_at(5.0, 5.0)], (2.0, 2.0))
+    s.fail(100.0)                          # failed twice: for good
+    assert set(s.avoid(1e6)) == {(2.0, 2.0), (5.0, 5.0)}
+    assert set(s.avoid_for_good()) == {(5.0, 5.0)}
+    # A room seen from its door (the goal reached there), whose frontier came back when the map was
+    # corrected: left out of the ranking while there is anything else, ranked when it is all there is.
+    m = room(door=(1.0, 2.0))
+    c = costmap_of(m)
+    door_goal = rank_frontiers(m, c, (2.0, 2.0))[0].goal
+    t = ExploreState()
+    t.choose(0.0, [Frontier(np.array([door_goal]), 1.0, door_goal, 1.0, 1.0)], (2.0, 2.0))
+    t.reached(10.0)
+    assert rank_frontiers(m, c, (2.0, 2.0), avoid=t.avoid(20.0), avoid_radius=1.5) == []
+    assert len(rank_frontiers(m, c, (2.0, 2.0), avoid=t.avoid_for_good(), avoid_radius=1.5)) == 1
 
 
 def frontier_at(x, y, cost=1.0):

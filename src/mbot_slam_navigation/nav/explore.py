@@ -6,7 +6,8 @@ cost = potential_scale * path length - gain_scale * frontier size; the current g
 another beats it by `hysteresis`; a goal move_base aborts, or one the robot makes no progress
 towards within progress_timeout, is blacklisted for blacklist_timeout with its frontier (after
 max_tries failures that frontier is given up, whatever goal it yields next); a goal reached is not
-sent again. Every run ends, with an outcome:
+sent again, and frontier cells near it count only when nothing else is left and their frontier is
+at least twice min_frontier_size (a room seen only from its door). Every run ends, with an outcome:
 - `complete`: no reachable frontier left (frontiers given up or unreachable are listed in the report);
 - `timeout`: max_duration [simulated s] passed (0: no limit);
 - `stuck`: goals fail, the robot has not moved for progress_timeout and move_base cannot move it;
@@ -81,6 +82,10 @@ from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
 BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot is stuck, not done
+# A frontier near a place visited before is gone back to (when nothing else is left) only if it is
+# this many times min_frontier_size: in the apartment the ones of 0.8-0.9 m were nooks that no
+# trip showed; the home's kitchen, seen only from its door, left one of 2.25 m.
+REVISIT_SIZE_FACTOR = 2.0
 
 
 def sim_sleep(seconds: float, poll: float = 0.02) -> None:
@@ -379,18 +384,28 @@ class Explore:
                     if escapes_failed >= 2:
                         return 'stuck'
                 continue
-            stats = {}
-            unreachable: List[GivenUp] = []
             m, m_stamp = self.map_with_stamp
             # One costmap for the whole cycle: the callback may replace it with a larger one (the
             # SLAM map grew) between two uses, and a goal found on one is no cell of the other.
             costmap = self.costmap
-            ranked = rank_frontiers(m, costmap, pose[:2], self.min_frontier_size, self.potential_scale,
-                                    self.gain_scale, self.state.avoid(now), self.state.blacklist_radius,
-                                    min_unknown_area=self.min_unknown_area, stats=stats,
-                                    avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
-            frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
-            self.given_up = given_up + unreachable
+            frontiers, waiting, stats = self.frontiers(now, m, m_stamp, costmap, pose, self.state.avoid(now))
+            revisit = False
+            if not frontiers and not waiting:
+                # Nothing left but what lies near places already visited (see
+                # ExploreState.avoid_for_good): a frontier there as large as a door (a room seen only
+                # from its doorway, whose frontier came back when the map was corrected) counts now;
+                # a smaller one (a nook behind furniture, seen from the floor as much as it can be)
+                # is given up, with why.
+                frontiers, waiting, stats = self.frontiers(now, m, m_stamp, costmap, pose,
+                                                           self.state.avoid_for_good())
+                revisit_size = REVISIT_SIZE_FACTOR * self.min_frontier_size
+                for f in frontiers:
+                    if f.size_m < revisit_size:
+                        x, y = f.cells.mean(axis=0)
+                        self.given_up.append(GivenUp(float(x), float(y), f.size_m, 'near places visited before and '
+                                                     'smaller than %.1f m' % revisit_size))
+                frontiers = [f for f in frontiers if f.size_m >= revisit_size]
+                revisit = bool(frontiers)
             claimed = 0
             if self.team_pub is not None:
                 mates = self.teammates()
@@ -411,8 +426,10 @@ class Explore:
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
                 self.send(new.goal[0], new.goal[1], yaw)
-                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m; %d frontiers', new.goal[0],
-                              new.goal[1], new.path_m, new.size_m, len(frontiers))
+                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m%s; %d frontiers', new.goal[0],
+                              new.goal[1], new.path_m, new.size_m,
+                              ' (near a place visited before: nothing else is left)' if revisit else '',
+                              len(frontiers))
             reachable_m2 = stats.get('reachable_m2', 0.0)
             if frontiers or self.state.goal is not None:
                 empty_cycles, boxed_since = 0, None
@@ -447,6 +464,20 @@ class Explore:
                                 self.goals_failed(), now, time.monotonic() - wall0), flush=True)
             self.wait_cycle()
         return None
+
+    def frontiers(self, now: float, m: Grid, m_stamp, costmap: Grid, pose, avoid) -> Tuple[List[Frontier], int, dict]:
+        """(frontiers that may be sent now, best first; how many wait out a blacklisting; the
+        ranking's stats), with the frontier cells near `avoid` left out; what is given up, and why,
+        goes to self.given_up (the report's list)."""
+        stats = {}
+        unreachable: List[GivenUp] = []
+        ranked = rank_frontiers(m, costmap, pose[:2], self.min_frontier_size, self.potential_scale,
+                                self.gain_scale, avoid, self.state.blacklist_radius,
+                                min_unknown_area=self.min_unknown_area, stats=stats,
+                                avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
+        frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
+        self.given_up = given_up + unreachable
+        return frontiers, waiting, stats
 
     def wait_cycle(self) -> None:
         """Until the next planning cycle: 1/planner_frequency, or sooner when move_base finishes the

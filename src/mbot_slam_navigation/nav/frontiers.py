@@ -126,7 +126,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     0..100: clear of the inflated zone, so move_base will not refuse it as occupied when the
     obstacle behind the frontier shows up), and not within avoid_radius of a point in
     `avoid_goals` (goals that failed: whatever shape the frontier has now, that goal is not sent
-    again). Frontiers large enough but with no such cell are appended to `unreachable`.
+    again). Frontiers large enough but with no such cell, or large enough only with the cells near
+    `avoid`, are appended to `unreachable`, with why.
     """
     rr, rc = costmap.cell_of(robot[0], robot[1])
     if not costmap.inside(rr, rc):
@@ -157,12 +158,18 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     out = []
     for g in frontier_groups(m, occupied_min, min_unknown_area):
         x, y = m.centre_of(g[:, 0], g[:, 1])
+        if len(x) * m.resolution < min_frontier_size:
+            continue
         if len(avoid):
             keep = np.min(np.hypot(x[:, None] - avoid[None, :, 0], y[:, None] - avoid[None, :, 1]), axis=1) >= avoid_radius
+            if keep.sum() * m.resolution < min_frontier_size:
+                if unreachable is not None:
+                    unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), len(x) * m.resolution,
+                                               'too little of it (%.2f m) lies farther than %.1f m from places '
+                                               'visited or given up' % (keep.sum() * m.resolution, avoid_radius)))
+                continue
             x, y = x[keep], y[keep]
         size = len(x) * m.resolution
-        if size < min_frontier_size:
-            continue
         cr, cc = costmap.cell_of(x, y)
         inside = costmap.inside(cr, cc)
         # the cells within goal_reach of the frontier, in a window around it (not the whole grid)
@@ -294,8 +301,17 @@ class ExploreState:
     places: List[List[float]] = field(default_factory=list)  # [x, y, new goals sent there]
 
     def avoid(self, now: float) -> List[Tuple[float, float]]:
-        """Places whose frontier cells do not count now (rank_frontiers' avoid)."""
+        """Places whose frontier cells do not count now (rank_frontiers' avoid): goals reached, and
+        goals that failed while blacklisted (for good after max_tries)."""
         return [g for b in self.blacklist if b.reached or b.until > now or b.tries >= self.max_tries for g in b.goals]
+
+    def avoid_for_good(self) -> List[Tuple[float, float]]:
+        """Places whose frontier cells never count again: goals that failed max_tries times. Cells
+        near a goal reached are left out only while other frontiers remain (so that the robot does
+        not turn back to a place it has been, where the map flickers); when nothing else is left,
+        they are what there is to explore (a room seen only from its door whose frontier came back
+        when the map was corrected). max_goals_per_place bounds the trips there."""
+        return [g for b in self.blacklist if not b.reached and b.tries >= self.max_tries for g in b.goals]
 
     def avoid_goals(self, now: float) -> List[Tuple[float, float]]:
         """Goals that failed and may not be sent now (rank_frontiers' avoid_goals)."""
