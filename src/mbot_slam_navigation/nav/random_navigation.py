@@ -50,6 +50,7 @@ BLOCKED_RETRIES = 2
 # move_base's abort texts for a way blocked, maybe for a moment (people walk on): the goal is in an
 # obstacle, or no plan was found even after the recoveries (a person resting in a door). Soaks lost
 # 2-3 goals in 100 to people in doors, each a goal the robot would have reached seconds later.
+# Checked in this order: an occupied goal's abort also begins 'Failed to find a valid plan'.
 BLOCKED_REASONS = {'goal occupied': 'occupied', 'Failed to find a valid plan': 'without a plan'}
 
 # actionlib_msgs/GoalStatus's states, in the order of their numbers (the tutorial's goal_states).
