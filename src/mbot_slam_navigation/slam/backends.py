@@ -163,6 +163,10 @@ class GraphSlam(_Backend):
         return self._impl.closures()
 
 
-def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
+def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
+    """background: the graph's loop closure in its own thread, as the node runs it (the particle
+    filter has none)."""
     defaults_of(backend)
-    return GraphSlam(laser_pose=laser_pose, **params) if backend == 'graph' else RbpfSlam(laser_pose=laser_pose, **params)
+    if backend == 'graph':
+        return GraphSlam(laser_pose=laser_pose, background=background, **params)
+    return RbpfSlam(laser_pose=laser_pose, **params)

@@ -79,20 +79,34 @@ class Progress:
         sys.stderr.flush()
 
 
-def run(scans, params, progress=True, backend=DEFAULT_BACKEND):
+def run(scans, params, progress=True, backend=DEFAULT_BACKEND, rate=0.0, background=False, online=None):
     """Runs a backend over the scans; returns (slam, cpu_seconds). The CPU time is the process's,
-    so it counts every thread (the graph backend runs synchronously here, on one core)."""
-    slam = make_slam(backend, params, scans[0].laser_pose)
+    so it counts every thread (the graph backend runs synchronously here, on one core, unless
+    `background`: then its loop closure runs in its own thread, as in the slam_gmapping node).
+    rate > 0 feeds the scans no faster than `rate` times the log's own time (as `rosbag play -r`
+    feeds a node), so that the CPU compares with a node's: a process that waits between scans
+    finds its caches cold and costs more than one that runs flat out. `online`, a list, receives
+    the pose the backend gives each scan as it is processed (what a node publishes then)."""
+    slam = make_slam(backend, params, scans[0].laser_pose, background=background)
     bar = Progress(len(scans), progress)
     cpu = 0.0
+    wall0, t0, start = time.time(), scans[0].time, time.process_time()
     for i, s in enumerate(scans):
+        if rate > 0:
+            wait = wall0 + (s.time - t0) / rate - time.time()
+            if wait > 0:
+                time.sleep(wait)
         c0 = time.process_time()
         slam.process_scan(s.odom, s.angle_min, s.angle_increment, 0.0, params.get('maxRange', 80.0), s.ranges, s.time)
         cpu += time.process_time() - c0
+        if online is not None:
+            online.append(slam.current_pose())
         bar.update(i + 1, slam.updates)
     c0 = time.process_time()
     slam.finish()
     cpu += time.process_time() - c0
+    if background or rate > 0:  # the closure thread also works while this one waits or updates the bar
+        cpu = time.process_time() - start
     return slam, cpu
 
 
