@@ -14,7 +14,7 @@ time) and the number of such corrections above 0.1 m, the node's CPU seconds (fr
 backend run offline on the same scans in this process (the trajectory it holds at the end, the
 pose each scan got as it was processed, its CPU seconds flat out) and once more fed at the bag's
 rate with the graph's closure thread, as the node runs it (its CPU seconds: a process that waits
-between scans costs more than one that runs flat out, 25% more on ACES here). The published
+between scans costs more than one that runs flat out, 25-37% more on ACES here). The published
 poses are written to bench/out/slam_node_<log>_<backend>.traj (`t x y theta`), the node's output
 to the .log beside it.
 

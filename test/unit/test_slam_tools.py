@@ -1,6 +1,7 @@
 """CARMEN reading and the relations metric on tiny fixtures."""
 import math
 import os
+import time
 
 import numpy as np
 import pytest
@@ -174,3 +175,23 @@ def test_corrections_as_the_robot_sees_them():
     assert moves[1, 1] == pytest.approx(0.2, abs=0.001) and moves[1, 2] == pytest.approx(0.01)
     assert moves[2, 1] == pytest.approx(0.3) and moves[2, 0] == 3.0
     assert corrections_at_robot(pubs[:1], odom_times, odom).shape == (0, 3)
+
+
+@pytest.mark.parametrize('backend', ['graph', 'rbpf'])
+def test_run_fed_at_a_rate_keeps_each_scans_pose_as_processed(backend):
+    """As `rosbag play -r 0.5` feeds a node: the run takes at least the log's span / 0.5, each
+    scan's pose as it was processed (what a node publishes) is kept, and the CPU seconds count the
+    whole process (the graph's closure thread included)."""
+    from mbot_slam_navigation.slam.offline import run
+    scans = read_log(os.path.join(DATA, 'tiny.clf'))
+    span = scans[-1].time - scans[0].time
+    online = []
+    t0 = time.monotonic()
+    slam, cpu = run(scans, {}, progress=False, backend=backend, rate=0.5, background=True, online=online)
+    assert time.monotonic() - t0 >= span / 0.5 - 0.02
+    assert len(online) == len(scans) and 0.0 < cpu
+    # The map frame starts at the first scan's odometry, (0, 0, 0) in tiny.clf.
+    assert online[0] == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
+    flat = []
+    run(scans, {}, progress=False, backend=backend, online=flat)
+    assert np.allclose(flat, online, atol=1e-6)  # pacing changes when, not what
