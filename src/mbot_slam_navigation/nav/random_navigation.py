@@ -39,6 +39,7 @@ from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import Point, Pose, PoseWithCovarianceStamped, Quaternion, Twist
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
+from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.params import ParamError, ParamReader
 from mbot_slam_navigation.transforms import check_planar_quaternion, yaw_to_quaternion
@@ -223,8 +224,9 @@ class RandomNavigation:
 
         self.cmd_vel_pub = rospy.Publisher('cmd_vel', Twist, queue_size=5)
         self.move_base = SimpleActionClient('move_base', MoveBaseAction)
-        self.tf = tf2_ros.Buffer()
-        self.tf_listener = tf2_ros.TransformListener(self.tf)
+        # /tf read lazily: only the pose lookups (a few a second) deserialize it; a
+        # TransformListener would deserialize all 40-odd messages a simulated second
+        self.tf = LazyTransformBuffer()
         self.new_pose: Optional[Tuple[float, float]] = None
         rospy.Subscriber('initialpose', PoseWithCovarianceStamped, self.update_initial_pose, queue_size=1)
         self.goal_active = False
