@@ -151,6 +151,24 @@ def test_state_keeps_its_goal_unless_clearly_beaten():
     assert s.choose(12.0, [], (0.0, 0.0)) is None and s.goal is None
 
 
+def test_a_goal_left_for_a_better_one_does_not_take_the_robot_back_for_a_while():
+    # Two frontiers whose costs take turns as the map grows: the robot left A for B and must not
+    # turn back to A while B's frontier is still there, only after switch_back_after.
+    s = ExploreState(hysteresis=1.0, switch_back_after=60.0)
+    a, b = frontier_at(1.0, 1.0, cost=5.0), frontier_at(5.0, 5.0, cost=3.0)
+    assert s.choose(0.0, [a], (0.0, 0.0)) is a
+    assert s.choose(3.0, [b, a], (0.0, 0.0)) is b and 'cost 3.0 against 5.0' in s.why
+    a_cheap, b_dear = frontier_at(1.0, 1.0, cost=1.0), frontier_at(5.0, 5.0, cost=6.0)
+    for t in (6.0, 30.0, 62.0):
+        assert s.choose(t, [a_cheap, b_dear], (0.0, 0.0)) is None and s.goal.goal == (5.0, 5.0)
+    assert s.choose(64.0, [a_cheap, b_dear], (0.0, 0.0)) is a_cheap  # 61 s after it was left
+    # a frontier that is gone frees the robot at once, whatever it left before
+    s2 = ExploreState(hysteresis=1.0)
+    s2.choose(0.0, [a], (0.0, 0.0))
+    s2.choose(3.0, [b, a], (0.0, 0.0))
+    assert s2.choose(6.0, [a_cheap], (0.0, 0.0)) is a_cheap and 'is gone' in s2.why
+
+
 def test_another_frontier_with_the_goal_being_driven_to_is_not_a_new_goal():
     s = ExploreState(hysteresis=1.0, max_goals_per_place=2)
     a = frontier_at(2.0, 1.0, cost=6.0)
@@ -199,6 +217,26 @@ def test_unknown_space_inside_furniture_makes_no_frontier_when_asked():
     assert len(frontier_groups(m)) == 2
     groups = frontier_groups(m, min_unknown_area=3.0)
     assert len(groups) == 1 and np.all(groups[0][:, 1] == int(6 / RES))  # the door only
+
+
+def test_floor_in_a_shadow_makes_a_frontier_though_small_and_enclosed():
+    # A room's corner beside its door, not seen from the doorway: 1.0 m x 1.2 m of unknown floor
+    # bounded by the walls on two sides and by seen floor on the other two. Furniture is bounded
+    # by what the laser saw of it (the test above); this by free space, so it is explored.
+    m = room(width_m=4.0, height_m=3.0)
+    m.data[int(1.05 / RES):int(2.25 / RES), int(1.05 / RES):int(2.05 / RES)] = -1
+    groups = frontier_groups(m, min_unknown_area=3.0)
+    assert len(groups) == 1 and len(groups[0]) * RES > 2.0
+    # a speck of unknown in the open (0.15 m square: a cell the laser skipped) is no frontier
+    s = room(width_m=4.0, height_m=3.0)
+    s.data[int(2.0 / RES):int(2.15 / RES), int(3.0 / RES):int(3.15 / RES)] = -1
+    assert frontier_groups(s, min_unknown_area=3.0) == []
+    # a map known up to its west and south edges but not its north one (the known cells' own
+    # bounding box touches the grid's edge: that component is not a shadow to look at)
+    k = room(width_m=4.0, height_m=3.0, unknown_beyond=False)
+    k.data[-10:, :] = -1
+    k.data[int(1.05 / RES):int(2.25 / RES), int(1.05 / RES):int(2.05 / RES)] = -1
+    assert len(frontier_groups(k, min_unknown_area=3.0)) == 2  # the shadow, and the unknown band along the edge
 
 
 def test_a_robot_inside_the_inscribed_zone_still_reaches_out_and_reachable_area_is_reported():
@@ -381,3 +419,17 @@ def test_the_team_report_is_complete_only_when_every_robot_is():
     assert f['per_robot']['robot2']['distance_m'] == 25.5
     assert team_figures({'robot1': a, 'robot2': dict(b, outcome='timeout')})['outcome'] == 'timeout'
     assert team_figures({'robot1': a, 'robot2': {'outcome': 'not_started'}})['outcome'] == 'not_started'
+
+
+def test_the_goal_being_driven_to_stays_the_frontiers_goal_while_it_is_still_valid():
+    # A frontier 2.6 m long (the room's east side open): its goal is the cell nearest the robot by
+    # path, which changes end as the robot moves; the goal being driven to is kept while it can be.
+    m = room(door=(0.2, 2.8))
+    c = costmap_of(m)
+    south = rank_frontiers(m, c, (4.2, 1.5))[0].goal
+    north = rank_frontiers(m, c, (4.2, 3.5))[0].goal
+    assert north[1] - south[1] > 1.0
+    kept = rank_frontiers(m, c, (4.2, 3.5), keep_goal=south)[0]
+    assert kept.goal == south and kept.path_m > rank_frontiers(m, c, (4.2, 3.5))[0].path_m
+    # a goal that is no cell of the frontier any more (inside the room, far from it) is not kept
+    assert rank_frontiers(m, c, (4.2, 3.5), keep_goal=(2.0, 2.0))[0].goal == north

@@ -3,7 +3,9 @@
 Every 1/planner_frequency seconds: frontiers of the SLAM map, each one's goal = its cell nearest to
 the robot by path on move_base's global costmap (so never inside an obstacle, never unreachable),
 cost = potential_scale * path length - gain_scale * frontier size; the current goal is kept unless
-another beats it by `hysteresis`; a goal move_base aborts, or one the robot makes no progress
+another beats it by `hysteresis`, and a goal left for a better one does not take the robot back
+from the current one for `switch_back_after` (60 s; as the map grows two frontiers' costs can take
+turns, and the robot would reach neither); a goal move_base aborts, or one the robot makes no progress
 towards within progress_timeout, is blacklisted for blacklist_timeout with its frontier (after
 max_tries failures that frontier is given up, whatever goal it yields next); a goal reached is not
 sent again, and frontier cells near it count only when nothing else is left and their frontier is
@@ -25,7 +27,7 @@ explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
 potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
 (0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
 transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
-hysteresis (1.0), min_unknown_area (3 m^2: enclosed unknown space smaller than this, the inside
+hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space smaller than this, the inside
 of furniture, makes no frontier), tour_frontiers (8: the frontiers re-ranked by the
 shortest tour through the goals of the 8 best, frontiers.tour_order, so that the robot finishes one
 side before it crosses to the other; 0 or 1: explore_lite's greedy choice; a team's robots choose
@@ -133,6 +135,7 @@ class Explore:
                                   blacklist_timeout=r.number('blacklist_timeout', 60.0, minimum=0.0),
                                   max_tries=r.integer('max_tries', 2, minimum=1),
                                   hysteresis=r.number('hysteresis', 1.0, minimum=0.0),
+                                  switch_back_after=r.number('switch_back_after', 60.0, minimum=0.0),
                                   max_goals_per_place=r.integer('max_goals_per_place', 5, minimum=1))
         self.return_to_start = r.boolean('return_to_start', True)
         self.report_dir = r.string('report_dir', '')
@@ -429,10 +432,10 @@ class Explore:
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
                 self.send(new.goal[0], new.goal[1], yaw)
-                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m%s; %d frontiers', new.goal[0],
-                              new.goal[1], new.path_m, new.size_m,
+                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m%s; %d frontiers; %s',
+                              new.goal[0], new.goal[1], new.path_m, new.size_m,
                               ' (near a place visited before: nothing else is left)' if revisit else '',
-                              len(frontiers))
+                              len(frontiers), self.state.why)
             reachable_m2 = stats.get('reachable_m2', 0.0)
             if frontiers or self.state.goal is not None:
                 empty_cycles, boxed_since = 0, None
@@ -477,7 +480,8 @@ class Explore:
         ranked = rank_frontiers(m, costmap, pose[:2], self.min_frontier_size, self.potential_scale,
                                 self.gain_scale, avoid, self.state.blacklist_radius,
                                 min_unknown_area=self.min_unknown_area, stats=stats,
-                                avoid_goals=self.state.avoid_goals(now), unreachable=unreachable)
+                                avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
+                                keep_goal=self.state.goal.goal if self.state.goal is not None else None)
         frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats
