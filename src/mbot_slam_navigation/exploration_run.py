@@ -100,11 +100,44 @@ def summary(r: dict, report_dir: str) -> str:
     return line
 
 
+def master_uri_of(launch: List[str], env=None) -> str:
+    """The ROS master the launch will use: roslaunch's -p PORT, else ROS_MASTER_URI."""
+    for flag, value in zip(launch, launch[1:]):
+        if flag in ('-p', '--port'):
+            return 'http://localhost:%s' % value
+    return (env if env is not None else os.environ).get('ROS_MASTER_URI', 'http://localhost:11311')
+
+
+def running_simulation(master_uri: str) -> Optional[str]:
+    """The simulator or explorer node already registered with the master at master_uri, if any
+    (None: no master there, or none of those nodes). roslaunch joins a master that runs already;
+    a second simulation on it takes over the first one's node names and publishes a second
+    /clock, and neither run means anything (two benches on one port did that)."""
+    import rosgraph.masterapi  # here: the module's helpers above run without ROS
+    master = rosgraph.masterapi.Master('/run_exploration', master_uri=master_uri)
+    try:
+        for node in ('/gazebo', '/explore'):
+            try:
+                master.lookupNode(node)
+                return node
+            except rosgraph.masterapi.MasterError:
+                continue
+    except (OSError, rosgraph.masterapi.MasterException):
+        return None  # no master there: roslaunch starts its own
+    return None
+
+
 def run(launch: List[str], wall_timeout: float, env=None, stdout=None) -> Optional[dict]:
     """Runs `roslaunch <launch...>` until report.json appears in its report_dir; the report or None."""
     report_dir = report_dir_of(launch)
     if report_dir is None:
         raise SystemExit('run_exploration: pass report_dir:=DIR among the roslaunch arguments')
+    uri = master_uri_of(launch, env)
+    other = running_simulation(uri)
+    if other is not None:
+        print('run_exploration: the ROS master at %s already has a node %s (another exploration or bench is '
+              'running there); not starting a second simulation on it' % (uri, other), flush=True)
+        return None
     report = os.path.join(report_dir, 'report.json')
     if os.path.exists(report):
         os.remove(report)  # a report from an earlier run must not end this one at once

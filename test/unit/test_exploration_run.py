@@ -93,3 +93,37 @@ def test_an_explorer_that_dies_without_a_report_ends_the_run_at_once(fake_launch
 def test_report_dir_is_required():
     with pytest.raises(SystemExit, match='report_dir'):
         exploration_run.run(['pkg', 'x.launch'], wall_timeout=1.0)
+
+
+def test_a_master_that_already_runs_a_simulation_is_not_joined(fake_launch, capsys):
+    # Two benches on one port: roslaunch would join the first one's master, and the second
+    # simulation would take over the first one's node names and publish a second /clock.
+    import socket
+    import subprocess
+    rosgraph = pytest.importorskip('rosgraph.masterapi')
+    with socket.socket() as s:
+        s.bind(('localhost', 0))
+        port = s.getsockname()[1]
+    uri = 'http://localhost:%d' % port
+    assert exploration_run.running_simulation(uri) is None  # nothing there: roslaunch starts its own
+    master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(100):
+            try:
+                rosgraph.Master('/probe', master_uri=uri).getPid()
+                break
+            except OSError:
+                time.sleep(0.1)
+        assert exploration_run.running_simulation(uri) is None  # a bare master (a user's roscore): joined
+        rosgraph.Master('/gazebo', master_uri=uri).registerPublisher('/clock', 'rosgraph_msgs/Clock',
+                                                                     'http://localhost:1/')
+        assert exploration_run.running_simulation(uri) == '/gazebo'
+        r = exploration_run.run(['-p', str(port), 'pkg', 'x.launch', 'report_dir:=%s' % fake_launch],
+                                wall_timeout=30.0)
+        assert r is None
+        assert 'already has a node /gazebo' in capsys.readouterr().out
+        assert not (fake_launch / 'stopped').exists()  # roslaunch was never started
+    finally:
+        master.terminate()
+        master.wait()

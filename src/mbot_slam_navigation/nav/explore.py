@@ -432,8 +432,8 @@ class Explore:
             if new is not None:
                 yaw = math.atan2(new.goal[1] - pose[1], new.goal[0] - pose[0])
                 self.send(new.goal[0], new.goal[1], yaw)
-                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m%s; %d frontiers; %s',
-                              new.goal[0], new.goal[1], new.path_m, new.size_m,
+                rospy.loginfo('explore: goal (%.2f, %.2f), %.1f m away, frontier %.1f m (%.1f m^2 unknown beside it)%s; '
+                              '%d frontiers; %s', new.goal[0], new.goal[1], new.path_m, new.size_m, new.unknown_m2,
                               ' (near a place visited before: nothing else is left)' if revisit else '',
                               len(frontiers), self.state.why)
             reachable_m2 = stats.get('reachable_m2', 0.0)

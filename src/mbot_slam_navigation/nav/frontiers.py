@@ -42,6 +42,9 @@ class Grid:
         return (rows >= 0) & (cols >= 0) & (rows < self.data.shape[0]) & (cols < self.data.shape[1])
 
 
+GAIN_RADIUS = 1.0  # [m] around a frontier's cells: the unknown space it borders (Frontier.unknown_m2)
+
+
 @dataclass
 class Frontier:
     cells: np.ndarray        # (N, 2) world x, y [m] of its cells
@@ -49,6 +52,7 @@ class Frontier:
     goal: Tuple[float, float]
     path_m: float            # path length from the robot to the goal [m]
     cost: float              # potential_scale * path_m - gain_scale * size_m (lower is better)
+    unknown_m2: float = math.inf  # [m^2] unknown space within GAIN_RADIUS of its cells (what it may show)
 
 
 @dataclass
@@ -64,7 +68,12 @@ class GivenUp:
 
 
 def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> List[np.ndarray]:
-    """The frontiers of map m as arrays of (row, col), largest first.
+    """The frontiers of map m as arrays of (row, col), largest first (see unknown_space)."""
+    return _frontier_groups(m, unknown_space(m, occupied_min, min_unknown_area), occupied_min)
+
+
+def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> np.ndarray:
+    """The cells of map m (uint8 mask) whose unknown space is there to explore.
 
     Unknown space that the map encloses (not reaching its edge) and smaller than min_unknown_area
     [m^2] does not make frontiers when walls bound most of it: it is the inside of furniture or a
@@ -94,6 +103,13 @@ def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0
             ring = (cv2.dilate(inside, cross) > 0) & (inside == 0)
             keep[i] = np.count_nonzero(ring & open_known[r0:r1, c0:c1]) >= 0.5 * np.count_nonzero(ring)
         unknown = keep[labels].astype(np.uint8)
+    return unknown
+
+
+def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int) -> List[np.ndarray]:
+    data = m.data.astype(np.int16)
+    open_known = (data >= 0) & (data < occupied_min)
+    cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
     n, labels = cv2.connectedComponents(frontier, connectivity=8)
     # one pass over the labelled cells, split by label (not one scan of the grid per group)
@@ -174,8 +190,11 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
     avoid = np.asarray(avoid, float).reshape(-1, 2)
     kr, kc = costmap.cell_of(*keep_goal) if keep_goal is not None else (-1, -1)
+    unknown = unknown_space(m, occupied_min, min_unknown_area)
+    g_reach = int(math.ceil(GAIN_RADIUS / m.resolution))
+    g_disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * g_reach + 1, 2 * g_reach + 1))
     out = []
-    for g in frontier_groups(m, occupied_min, min_unknown_area):
+    for g in _frontier_groups(m, unknown, occupied_min):
         x, y = m.centre_of(g[:, 0], g[:, 1])
         if len(x) * m.resolution < min_frontier_size:
             continue
@@ -187,7 +206,15 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                                                'too little of it (%.2f m) lies farther than %.1f m from places '
                                                'visited or given up' % (keep.sum() * m.resolution, avoid_radius)))
                 continue
-            x, y = x[keep], y[keep]
+            x, y, g = x[keep], y[keep], g[keep]
+        # the unknown space it borders, within GAIN_RADIUS of its cells (in a window around it)
+        ur0, uc0 = max(int(g[:, 0].min()) - g_reach, 0), max(int(g[:, 1].min()) - g_reach, 0)
+        ur1 = min(int(g[:, 0].max()) + g_reach + 1, unknown.shape[0])
+        uc1 = min(int(g[:, 1].max()) + g_reach + 1, unknown.shape[1])
+        cells = np.zeros((ur1 - ur0, uc1 - uc0), np.uint8)
+        cells[g[:, 0] - ur0, g[:, 1] - uc0] = 1
+        unknown_m2 = float(np.count_nonzero((cv2.dilate(cells, g_disc) > 0) & (unknown[ur0:ur1, uc0:uc1] > 0))
+                           ) * m.resolution ** 2
         size = len(x) * m.resolution
         cr, cc = costmap.cell_of(x, y)
         inside = costmap.inside(cr, cc)
@@ -215,7 +242,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
         gx, gy = costmap.centre_of(gr, gc)
         path_m = float(d[wr, wc]) * costmap.resolution
         out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
-                            potential_scale * path_m - gain_scale * size))
+                            potential_scale * path_m - gain_scale * size, unknown_m2))
     return sorted(out, key=lambda f: f.cost)
 
 
