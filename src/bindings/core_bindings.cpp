@@ -451,6 +451,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("cauchy_scale", &GraphSlamParams::cauchy_scale)
       .def_readwrite("redundant_distance", &GraphSlamParams::redundant_distance)
       .def_readwrite("redundant_angle", &GraphSlamParams::redundant_angle)
+      .def_readwrite("keep_trimmed_scans", &GraphSlamParams::keep_trimmed_scans)
       .def_readwrite("keep_scan_poses", &GraphSlamParams::keep_scan_poses)
       .def_readwrite("loop_solve_chi2", &GraphSlamParams::loop_solve_chi2)
       .def_readwrite("background", &GraphSlamParams::background)

@@ -208,7 +208,7 @@ void GraphSlam::trimLocked() {
   while (released_upto_ < done) nodes_[++released_upto_].points.reset();
   while (!redundant_.empty() && redundant_.front() <= done) {
     const int k = redundant_.front();
-    nodes_[k].scan.reset();
+    if (!params_.keep_trimmed_scans) nodes_[k].scan.reset();
     redundant_.pop_front();
     ++stats_.trimmed_nodes;
     if (!nodes_[k].anchor) mergeLocked(k);

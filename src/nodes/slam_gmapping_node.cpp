@@ -154,6 +154,7 @@ class SlamGmappingNode {
     param("loop_candidates", g.loop_candidates);
     param("redundant_distance", g.redundant_distance);
     param("redundant_angle", g.redundant_angle);
+    param("keep_trimmed_scans", g.keep_trimmed_scans);
     param("loop_solve_chi2", g.loop_solve_chi2);
     g.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
     // The parameters both backends share have gmapping's names; read once above.

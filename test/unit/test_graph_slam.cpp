@@ -1,5 +1,7 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <random>
 #include <vector>
 
@@ -183,6 +185,31 @@ TEST(GraphSlam, GoingRoundTheSameLoopKeepsScansOnlyForNewPlaces) {
   endError(reference, d, w, 0, 3 * lap);
   EXPECT_EQ(reference.stats().trimmed_nodes, 0);
   EXPECT_GT(reference.stats().submaps, two.submaps + 5);
+}
+
+// keep_trimmed_scans: the same estimate (trimmed nodes still leave the optimization), but a map
+// rebuilt after a closure still counts what the trimmed nodes saw.
+TEST(GraphSlam, KeepingTrimmedScansChangesTheMapNotTheEstimate) {
+  const World2D w = squareCorridor();
+  const Drive d = laps(4);
+  GraphSlam trimmed(corridorParams());
+  GraphSlamParams keep = corridorParams();
+  keep.keep_trimmed_scans = true;
+  GraphSlam kept(keep);
+  endError(trimmed, d, w);
+  endError(kept, d, w);
+  const GraphSlamStats a = trimmed.stats(), b = kept.stats();
+  ASSERT_GT(a.trimmed_nodes, 50);
+  EXPECT_EQ(a.trimmed_nodes, b.trimmed_nodes);
+  EXPECT_EQ(a.merged_nodes, b.merged_nodes);
+  EXPECT_EQ(a.optimizations, b.optimizations);
+  EXPECT_LT((trimmed.currentPose() - kept.currentPose()).norm(), 1e-9);
+  auto known = [](const OccupancyImage& img) {
+    return std::count_if(img.data.begin(), img.data.end(), [](int8_t v) { return v >= 0; });
+  };
+  const OccupancyImage ia = trimmed.occupancy(0.25), ib = kept.occupancy(0.25);
+  std::cout << "known cells: trimmed scans freed " << known(ia) << ", kept " << known(ib) << std::endl;
+  EXPECT_GT(known(ib), known(ia));
 }
 
 // A robot that turns on the spot (at every goal, in recoveries) makes a node every angularUpdate.

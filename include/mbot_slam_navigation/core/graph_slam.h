@@ -113,6 +113,11 @@ struct GraphSlamParams {
   /// submap need it (`~redundant_distance`); 0 keeps every node's scan.
   double redundant_distance = 0.3;
   double redundant_angle = 0.5;     ///< [rad] (`~redundant_angle`; not used for a laser that sees all round)
+  /// A trimmed node still leaves the optimization and frees its match points, but keeps its scan
+  /// for the map (`~keep_trimmed_scans`): a map rebuilt after a closure then still counts what it
+  /// saw (a revisit's scans show door jambs and furniture sides at other angles; without them an
+  /// explorer chases the frontiers that come back). Memory then grows with the scans taken.
+  bool keep_trimmed_scans = false;
   /// Keep every scan's tracked pose for scanPoses() (offline scoring; 40 bytes a scan, so the node
   /// turns it off).
   bool keep_scan_poses = true;
