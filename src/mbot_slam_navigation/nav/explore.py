@@ -27,8 +27,9 @@ explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
 potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
 (0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
 transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
-hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space smaller than this, the inside
-of furniture, makes no frontier), tour_frontiers (8: the frontiers re-ranked by the
+hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space
+smaller than this, the inside of furniture, makes no frontier unless free floor bounds most of it:
+then it is floor in a shadow), tour_frontiers (8: the frontiers re-ranked by the
 shortest tour through the goals of the 8 best, frontiers.tour_order, so that the robot finishes one
 side before it crosses to the other; 0 or 1: explore_lite's greedy choice; a team's robots choose
 greedily), return_to_start (true), report_dir (''), world_name ('' = the simulator's
