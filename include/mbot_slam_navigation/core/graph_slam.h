@@ -35,8 +35,9 @@
 // redundant_angle of its heading (any heading if the laser sees all round), is redundant: it joins
 // the chain and is matched against the nearest submap (so the robot stays anchored to the old
 // map), but once the local map and its submap no longer need it, its scan is freed (so the map,
-// when rebuilt, no longer counts what it saw), and a submap made mostly of redundant nodes is not
-// kept. Match points are freed from every node at that point. The trimmed node then leaves the
+// when rebuilt, no longer counts what it saw; keep_trimmed_scans keeps it for the map only), and a
+// submap made mostly of redundant nodes is not kept. Match points are freed from every node at
+// that point. The trimmed node then leaves the
 // optimization too: its two chain edges become one (the measurements composed, the covariances
 // propagated) and its closures are dropped (they only tied a revisit to a map that other nodes
 // hold); it keeps its pose relative to the node before it, and moves with it. What is kept and
