@@ -10,6 +10,7 @@ import argparse
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -115,6 +116,10 @@ def running_simulation(master_uri: str) -> Optional[str]:
     /clock, and neither run means anything (two benches on one port did that)."""
     import rosgraph.masterapi  # here: the module's helpers above run without ROS
     master = rosgraph.masterapi.Master('/run_exploration', master_uri=master_uri)
+    # xmlrpc waits as long as the socket does: a master URI on a host that does not answer must not
+    # hold the run (socket.timeout is an OSError: then roslaunch's own error says what is wrong)
+    previous = socket.getdefaulttimeout()
+    socket.setdefaulttimeout(5.0)
     try:
         for node in ('/gazebo', '/explore'):
             try:
@@ -124,6 +129,8 @@ def running_simulation(master_uri: str) -> Optional[str]:
                 continue
     except (OSError, rosgraph.masterapi.MasterException):
         return None  # no master there: roslaunch starts its own
+    finally:
+        socket.setdefaulttimeout(previous)
     return None
 
 
