@@ -14,6 +14,7 @@ import socket
 import subprocess
 import sys
 import time
+import xmlrpc.client
 from typing import Dict, List, Optional
 
 
@@ -127,8 +128,8 @@ def running_simulation(master_uri: str) -> Optional[str]:
                 return node
             except rosgraph.masterapi.MasterError:
                 continue
-    except (OSError, rosgraph.masterapi.MasterException):
-        return None  # no master there: roslaunch starts its own
+    except (OSError, xmlrpc.client.Error, rosgraph.masterapi.MasterException):
+        return None  # no master there (or no ROS master: an HTTP error): roslaunch decides
     finally:
         socket.setdefaulttimeout(previous)
     return None
