@@ -183,7 +183,8 @@ class NavigationFaultsTest(unittest.TestCase):
         with open(points, 'w') as f:
             f.write('visitor_spot: {position: [%.2f, %.2f], yaw: 0.0}\n' % goal)
         with random_navigation('_max_goals:=1', '_locations_file:=' + points) as (nav, out):
-            self.assertTrue(wait_for(lambda: any('as occupied' in l for l in out), 240.0),
+            # Polled every 0.05 s of wall time: at 20x a 2 s poll let the person stay 40 s longer.
+            self.assertTrue(wait_for(lambda: any('as occupied' in l for l in out), 240.0, 0.05),
                             'random_navigation did not say the goal was occupied:\n' + ''.join(out)[-3000:])
             self.assertTrue(delete(model_name='visitor').success)
             nav.wait(timeout=600)
@@ -239,7 +240,11 @@ class NavigationFaultsTest(unittest.TestCase):
             f.write('kitchen: {position: [2.2, -5.0], yaw: 0.0}\n')
         try:
             with random_navigation('_max_goals:=1', '_locations_file:=' + points) as (nav, out):
-                self.assertTrue(wait_for(lambda: any('for the way to clear' in l for l in out), 400.0),
+                # The person leaves as soon as the script says it waits (polled every 0.05 s of wall
+                # time). With the 2 s poll, CI (at about 20x) let them stand 40 s longer, through a
+                # second attempt whose recoveries spun the robot in place: SLAM then had them in
+                # /map, and the global costmap's static layer kept the door shut after they left.
+                self.assertTrue(wait_for(lambda: any('for the way to clear' in l for l in out), 400.0, 0.05),
                                 'random_navigation did not wait for the way to clear:\n' + ''.join(out)[-3000:])
                 rospy.loginfo('with a person in the door: %s', [l for l in out if 'for the way to clear' in l][0])
                 self.assertTrue(delete(model_name='door_visitor').success)
