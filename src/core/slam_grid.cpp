@@ -64,18 +64,28 @@ void SlamGrid::growToInclude(const Eigen::Vector2d& min_m, const Eigen::Vector2d
 }
 
 void SlamGrid::registerBeam(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit) {
-  const Cell end = worldToCell(to);
+  const Cell start = worldToCell(from), end = worldToCell(to);
   const int w = width(), h = height();
-  walkLine(worldToCell(from), end, [&](const Cell& c) {
+  // In squared cells, so that the hot loop compares integers.
+  const double range_cells = kClearRange / resolution_, beyond_cells = kClearBeyond / resolution_;
+  const long range2 = static_cast<long>(range_cells * range_cells);
+  const long beyond2 = static_cast<long>(std::ceil(beyond_cells * beyond_cells));
+  walkLine(start, end, [&](const Cell& c) {
     if (c.x < 0 || c.y < 0 || c.x >= w || c.y >= h) return true;
     HitCell& cell = writableCell(c);
-    ++cell.visits;
-    if (hit && c == end) {
-      const Eigen::Vector2d offset = to - cellCenter(c);
-      cell.acc_x += static_cast<float>(offset.x());
-      cell.acc_y += static_cast<float>(offset.y());
-      ++cell.hits;
+    if (cell.visits < (1u << 28) - 1) ++cell.visits;
+    if (c == end) {
+      if (hit) {
+        const Eigen::Vector2d offset = to - cellCenter(c);
+        cell.acc_x += static_cast<float>(offset.x());
+        cell.acc_y += static_cast<float>(offset.y());
+        ++cell.hits;
+        cell.clears = 0;
+      }
+      return true;
     }
+    const long fx = c.x - start.x, fy = c.y - start.y, ex = end.x - c.x, ey = end.y - c.y;
+    if (cell.clears < 15 && fx * fx + fy * fy <= range2 && ex * ex + ey * ey >= beyond2) ++cell.clears;
     return true;
   });
 }
@@ -107,8 +117,7 @@ OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
         int8_t* row = &img.data[static_cast<std::size_t>((py - py0) * kPatchSize + cy) * img.width + (px - px0) * kPatchSize];
         const HitCell* cells = &patch->cells[cy << kPatchBits];
         for (int cx = 0; cx < kPatchSize; ++cx) {
-          const double occ = cells[cx].occupancy();
-          if (occ >= 0.0) row[cx] = occ > occ_thresh ? 100 : 0;
+          if (cells[cx].visits) row[cx] = occupied(cells[cx], occ_thresh) ? 100 : 0;
         }
       }
     }

@@ -115,8 +115,8 @@ TEST(SlamGrid, OccupancyImageIsEveryCellsRatioCroppedToTheWrittenPatches) {
     for (int y = 0; y < img.height; ++y) {
       for (int x = 0; x < img.width; ++x) {
         const Eigen::Vector2d centre = img.origin + Eigen::Vector2d(x + 0.5, y + 0.5) * img.resolution;
-        const double occ = g.cell(g.worldToCell(centre)).occupancy();
-        const int expected = occ < 0.0 ? -1 : (occ > thresh ? 100 : 0);
+        const HitCell& cell = g.cell(g.worldToCell(centre));
+        const int expected = cell.visits == 0 ? -1 : (SlamGrid::occupied(cell, thresh) ? 100 : 0);
         ASSERT_EQ(img.data[static_cast<std::size_t>(y) * img.width + x], expected) << "cell " << x << ", " << y;
         known += expected >= 0;
         occupied += expected == 100;
@@ -127,6 +127,64 @@ TEST(SlamGrid, OccupancyImageIsEveryCellsRatioCroppedToTheWrittenPatches) {
     EXPECT_LT(occupied, occupied_before);  // a higher threshold calls fewer cells occupied
     occupied_before = occupied;
   }
+}
+
+namespace {
+int shown(const SlamGrid& g, const Eigen::Vector2d& p) {
+  const OccupancyImage img = g.toOccupancy(0.25);
+  const int x = static_cast<int>(std::floor((p.x() - img.origin.x()) / img.resolution));
+  const int y = static_cast<int>(std::floor((p.y() - img.origin.y()) / img.resolution));
+  return img.data[static_cast<std::size_t>(y) * img.width + x];
+}
+/// Occupied cells of the map within `r` of `p`.
+int occupiedNear(const SlamGrid& g, const Eigen::Vector2d& p, double r) {
+  int n = 0;
+  for (double dx = -r; dx <= r + 1e-9; dx += g.resolution())
+    for (double dy = -r; dy <= r + 1e-9; dy += g.resolution()) n += shown(g, p + Eigen::Vector2d(dx, dy)) == 100;
+  return n;
+}
+}  // namespace
+
+TEST(SlamGrid, APersonWhoLeftIsClearedWhileWallsSeenAtAGrazeStay) {
+  // The robot at the origin turns in place in front of a door (a gap in the wall y = -1.3) in
+  // which a person stands 0.25 m deep: 60 scans of 360 beams see them. They leave; the next
+  // scans see through the door to the room's far wall 3 m beyond. gmapping's ratio alone keeps
+  // the person's cells occupied until 180 scans have seen through them.
+  World2D with_person;
+  with_person.addBox({-1.5, -1.3}, 0, 2.0, 0.1);  // the wall, door x -0.5..0.5
+  with_person.addBox({1.5, -1.3}, 0, 2.0, 0.1);
+  with_person.addBox({0, -4.3}, 0, 6.0, 0.1);  // the far room's far wall
+  World2D without = with_person;
+  with_person.addCylinder({0.0, -1.55}, 0.25);
+  SlamGrid g({-4, -5}, {4, 2}, 0.05);
+  ScanMatcher m(matcherParams(), 0.05);
+  std::mt19937 rng(3);
+  for (int k = 0; k < 60; ++k) {
+    const Eigen::Vector3d pose(0, 0, 0.1 * k);
+    m.registerScan(g, pose, scanAt(with_person, pose, rng));
+  }
+  const Eigen::Vector2d person(0.0, -1.33);
+  ASSERT_GE(occupiedNear(g, person, 0.1), 3) << "the person is not in the map";
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d pose(0, 0, 0.1 * k);
+    m.registerScan(g, pose, scanAt(without, pose, rng));
+  }
+  EXPECT_EQ(occupiedNear(g, person, 0.15), 0) << "the person's cells show occupied after they left";
+  EXPECT_GT(g.cell(g.worldToCell({0.0, -1.32})).occupancy(), 0.25);  // the ratio alone would keep it
+  // The walls beside the door, seen at a graze from a robot driving along them 0.2 m away, stay:
+  // the beams that pass through their cells end on them within kClearBeyond.
+  int wall = 0, worn = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Eigen::Vector3d pose(-3.5 + 0.035 * k, -1.05, 0.0);
+    m.registerScan(g, pose, scanAt(without, pose, rng));
+  }
+  for (double x = -2.4; x < 2.4; x += 0.05) {
+    if (std::abs(x) < 0.6) continue;  // the door
+    ++wall;
+    worn += shown(g, {x, -1.27}) != 100 && shown(g, {x, -1.32}) != 100;
+  }
+  EXPECT_GT(wall, 60);
+  EXPECT_EQ(worn, 0) << "wall cells shown free after a drive along the wall";
 }
 
 TEST(MotionModel, SampleStatisticsMatchTheParameters) {

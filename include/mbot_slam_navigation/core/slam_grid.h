@@ -20,13 +20,19 @@ namespace mbot {
 namespace core {
 
 struct HitCell {
+  HitCell() : visits(0), clears(0) {}
   float acc_x = 0.0f;   ///< sum of hit points' offsets from the cell centre [m]
   float acc_y = 0.0f;
   uint32_t hits = 0;
-  uint32_t visits = 0;  ///< beams that ended in or passed through the cell
+  uint32_t visits : 28;  ///< beams that ended in or passed through the cell
+  /// Beams that passed clear through the cell since its last hit (see SlamGrid::kClearRange),
+  /// saturating at 15. Four bits beside `visits` keep the cell at 16 bytes: every particle's map
+  /// is made of these.
+  uint32_t clears : 4;
   /// hits / visits, or -1 when never visited.
   double occupancy() const { return visits ? static_cast<double>(hits) / visits : -1.0; }
 };
+static_assert(sizeof(HitCell) == 16, "a HitCell is 16 bytes: the particles' maps are made of them");
 
 /// An occupancy picture of a SlamGrid, cropped to the part that was ever written.
 struct OccupancyImage {
@@ -67,10 +73,33 @@ class SlamGrid {
   /// Grows (whole patches) so that the box [min, max] (world, m) lies inside.
   void growToInclude(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m);
   /// One beam from `from` to `to` (world, m): cells before the end are visited; the end cell is
-  /// visited and, if `hit`, gains a hit at `to`.
+  /// visited and, if `hit`, gains a hit at `to` (and its `clears` restart from 0). A cell within
+  /// kClearRange of `from` and at least kClearBeyond before `to` was passed clear through, and
+  /// gains a clear.
   void registerBeam(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit);
 
-  /// gmapping's map: a visited cell with hits / visits > occ_thresh is occupied, else free.
+  /// Someone who stood still in the robot's view (a person in a door while the robot turned in
+  /// its recoveries) gains as many hits as scans were taken, and gmapping's ratio keeps the cell
+  /// occupied until three times as many beams have passed through it: the planner, which plans on
+  /// this map, kept a door shut for minutes after they left. So a cell that kClearsToFree beams
+  /// have passed clear through since its last hit shows free, whatever its ratio.
+  ///
+  /// Walls must not be worn away by this. A beam passes through a wall's cells only where it
+  /// grazes the wall, and then only within res / sin(angle) of where it ends on it; a cell at most
+  /// kClearRange from the laser, which stands at least h from any wall, is grazed at
+  /// sin(angle) >= h / kClearRange. Counting only cells at least kClearBeyond before the beam's end
+  /// therefore never counts a wall cell while h > res * kClearRange / kClearBeyond: 0.1 m at
+  /// 0.05 m cells (the laser is inside the robot's footprint), 0.2 m at 0.1 m cells.
+  static constexpr double kClearRange = 2.0;   ///< [m] from the laser
+  static constexpr double kClearBeyond = 1.0;  ///< [m] before the beam's end
+  static constexpr unsigned kClearsToFree = 4;
+  /// Whether the map shows `c` occupied: hits / visits > occ_thresh (gmapping), and fewer than
+  /// kClearsToFree clears since its last hit.
+  static bool occupied(const HitCell& c, double occ_thresh) {
+    return c.visits && c.hits > occ_thresh * c.visits && c.clears < kClearsToFree;
+  }
+
+  /// gmapping's map: a visited cell that is occupied() shows 100, any other visited cell 0.
   OccupancyImage toOccupancy(double occ_thresh) const;
   /// Patches allocated by this grid alone (not shared with any other grid) and in all.
   int ownedPatches() const;
