@@ -82,6 +82,7 @@ from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp,
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
+from mbot_slam_navigation.topic_watch import WatchedSubscriber
 from mbot_slam_navigation.transforms import quaternion_to_yaw
 
 
@@ -177,8 +178,12 @@ class Explore:
         self.tf = LazyTransformBuffer()
         # numpy_msg: the grids arrive as numpy arrays, not as tuples of Python ints (a 53k-cell
         # grid: 0.01 ms instead of 2.4 ms here)
-        rospy.Subscriber(map_topic, numpy_msg(OccupancyGrid), self.on_map, queue_size=1, buff_size=2 ** 24)
-        rospy.Subscriber(costmap_topic, numpy_msg(OccupancyGrid), self.on_costmap, queue_size=1, buff_size=2 ** 24)
+        # Started by the same roslaunch as SLAM and move_base: a connection rospy lost while both
+        # registered is made again during the start-up wait (topic_watch).
+        self.inputs = [WatchedSubscriber(map_topic, numpy_msg(OccupancyGrid), self.on_map, queue_size=1,
+                                         buff_size=2 ** 24),
+                       WatchedSubscriber(costmap_topic, numpy_msg(OccupancyGrid), self.on_costmap, queue_size=1,
+                                         buff_size=2 ** 24)]
         rospy.Subscriber('/gazebo/contacts', Contact, self.on_contact)
         self.scan_topic = scan_topic  # subscribed only while backing out
         self.cmd_pub = rospy.Publisher(cmd_vel_topic, Twist, queue_size=1)  # only while backing out
@@ -325,6 +330,7 @@ class Explore:
         rospy.loginfo('explore: waiting for move_base, the map and the global costmap...')
         waited = time.monotonic()
         start = None
+        checked = 0.0
         while not rospy.is_shutdown():
             if self.move_base.wait_for_server(rospy.Duration(0.5)):
                 start = self.robot_pose()
@@ -338,6 +344,10 @@ class Explore:
                 return
             if elapsed > 20.0:
                 rospy.logwarn_throttle(30.0, 'explore: still waiting (%.0f s) for %s' % (elapsed, self.missing(start)))
+            if elapsed > checked + 5.0:
+                checked = elapsed
+                for sub in self.inputs:
+                    sub.check()
             time.sleep(0.5)  # wall time: simulated time may not run yet
         if rospy.is_shutdown():
             return
