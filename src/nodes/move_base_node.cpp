@@ -693,6 +693,23 @@ class MoveBase {
       // hundreds of seconds ahead ("extrapolation ... only time 398.18 is in the buffer").
       // Static transforms survive a clear.
       tf_.clear();
+    } else if (!clock_seen_.isZero()) {
+      // A tf message stamped before the jump can still be handled after that clear (seen on a busy
+      // machine: "only time 491.04 is in the buffer" at 52 s, the robot pose unavailable for
+      // controller_patience). tf2 then refuses every newer message as older than its cache, until
+      // the clock catches up. So the robot's newest transform must never be ahead of the clock.
+      const auto& c = global_->config();
+      try {
+        const ros::Time newest = tf_.lookupTransform(c.global_frame, c.robot_base_frame, ros::Time(0)).header.stamp;
+        if (newest > now + ros::Duration(1.0)) {
+          ROS_WARN("move_base: tf holds %s -> %s at %.2f s, ahead of the clock (%.2f s): a message from before the "
+                   "clock went back; the tf buffer is cleared again", c.robot_base_frame.c_str(),
+                   c.global_frame.c_str(), newest.toSec(), now.toSec());
+          tf_.clear();
+        }
+      } catch (const tf2::TransformException&) {
+        // no transform yet: nothing ahead of the clock
+      }
     }
     clock_seen_ = now;
     if (!server_reset_pending_ || executing_) return;
