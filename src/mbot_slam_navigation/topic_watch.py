@@ -13,17 +13,38 @@ how many publishers the topic has; if the subscription has fewer connections at 
 row (a connection being made is given one period), it unregisters and subscribes again: a fresh
 registerSubscriber answer lists every publisher, and a latched message comes again.
 """
+import xmlrpc.client
 from typing import Callable, Optional
 
 import rosgraph
 import rospy
 
+MASTER_TIMEOUT = 3.0  # [s, wall] for the master's answer; xmlrpc alone would wait as long as the socket
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    """An xmlrpc transport whose connection gives up after `timeout` s (per connection: a
+    process-wide socket timeout would reach rospy's own sockets too)."""
+
+    def __init__(self, timeout: float):
+        super().__init__()
+        self.timeout = timeout
+
+    def make_connection(self, host):
+        conn = super().make_connection(host)
+        conn.timeout = self.timeout
+        return conn
+
 
 def master_publisher_count(topic: str) -> int:
-    """Publishers of `topic` (resolved) that the master lists, or -1 when the master does not answer."""
+    """Publishers of `topic` (resolved) that the master lists, or -1 when the master does not answer
+    within MASTER_TIMEOUT."""
     try:
-        publishers, _, _ = rosgraph.Master(rospy.get_name()).getSystemState()
-    except Exception:  # the master gone or busy: nothing to conclude this time
+        master = xmlrpc.client.ServerProxy(rosgraph.get_master_uri(), transport=_TimeoutTransport(MASTER_TIMEOUT))
+        code, _, (publishers, _, _) = master.getSystemState(rospy.get_name())
+    except Exception:  # the master gone, busy or not a master: nothing to conclude this time
+        return -1
+    if code != 1:
         return -1
     return next((len(nodes) for name, nodes in publishers if name == topic), 0)
 
