@@ -10,12 +10,13 @@ import argparse
 import json
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
 import xmlrpc.client
 from typing import Dict, List, Optional
+
+from mbot_slam_navigation.master_rpc import master_proxy
 
 
 EXPLORERS = ('explore', 'explore_team')  # node names whose report run() waits for
@@ -115,23 +116,16 @@ def running_simulation(master_uri: str) -> Optional[str]:
     (None: no master there, or none of those nodes). roslaunch joins a master that runs already;
     a second simulation on it takes over the first one's node names and publishes a second
     /clock, and neither run means anything (two benches on one port did that)."""
-    import rosgraph.masterapi  # here: the module's helpers above run without ROS
-    master = rosgraph.masterapi.Master('/run_exploration', master_uri=master_uri)
-    # xmlrpc waits as long as the socket does: a master URI on a host that does not answer must not
-    # hold the run (socket.timeout is an OSError: then roslaunch's own error says what is wrong)
-    previous = socket.getdefaulttimeout()
-    socket.setdefaulttimeout(5.0)
+    # A master URI on a host that does not answer must not hold the run: 5 s, then roslaunch's
+    # own error says what is wrong.
+    master = master_proxy(master_uri, 5.0)
     try:
         for node in ('/gazebo', '/explore'):
-            try:
-                master.lookupNode(node)
+            code, _, _ = master.lookupNode('/run_exploration', node)
+            if code == 1:
                 return node
-            except rosgraph.masterapi.MasterError:
-                continue
-    except (OSError, xmlrpc.client.Error, rosgraph.masterapi.MasterException):
+    except (OSError, xmlrpc.client.Error):
         return None  # no master there (or no ROS master: an HTTP error): roslaunch decides
-    finally:
-        socket.setdefaulttimeout(previous)
     return None
 
 

@@ -13,35 +13,22 @@ how many publishers the topic has; if the subscription has fewer connections at 
 row (a connection being made is given one period), it unregisters and subscribes again: a fresh
 registerSubscriber answer lists every publisher, and a latched message comes again.
 """
-import xmlrpc.client
 from typing import Callable, Optional
 
 import rosgraph
 import rospy
 
-MASTER_TIMEOUT = 3.0  # [s, wall] for the master's answer; xmlrpc alone would wait as long as the socket
+from mbot_slam_navigation.master_rpc import master_proxy
 
-
-class _TimeoutTransport(xmlrpc.client.Transport):
-    """An xmlrpc transport whose connection gives up after `timeout` s (per connection: a
-    process-wide socket timeout would reach rospy's own sockets too)."""
-
-    def __init__(self, timeout: float):
-        super().__init__()
-        self.timeout = timeout
-
-    def make_connection(self, host):
-        conn = super().make_connection(host)
-        conn.timeout = self.timeout
-        return conn
+MASTER_TIMEOUT = 3.0  # [s, wall] for the master's answer
 
 
 def master_publisher_count(topic: str) -> int:
     """Publishers of `topic` (resolved) that the master lists, or -1 when the master does not answer
     within MASTER_TIMEOUT."""
     try:
-        master = xmlrpc.client.ServerProxy(rosgraph.get_master_uri(), transport=_TimeoutTransport(MASTER_TIMEOUT))
-        code, _, (publishers, _, _) = master.getSystemState(rospy.get_name())
+        code, _, (publishers, _, _) = master_proxy(rosgraph.get_master_uri(), MASTER_TIMEOUT).getSystemState(
+            rospy.get_name())
     except Exception:  # the master gone, busy or not a master: nothing to conclude this time
         return -1
     if code != 1:
