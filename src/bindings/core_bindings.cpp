@@ -436,6 +436,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("local_min_score", &GraphSlamParams::local_min_score)
       .def_readwrite("local_prior_margin", &GraphSlamParams::local_prior_margin)
       .def_readwrite("local_prior_weight", &GraphSlamParams::local_prior_weight)
+      .def_readwrite("local_prior_points", &GraphSlamParams::local_prior_points)
       .def_readwrite("local_visible_only", &GraphSlamParams::local_visible_only)
       .def_readwrite("submap_nodes", &GraphSlamParams::submap_nodes)
       .def_readwrite("loop_search_radius", &GraphSlamParams::loop_search_radius)
@@ -466,6 +467,8 @@ PYBIND11_MODULE(_core, m) {
              py::dict d;
              d["nodes"] = st.nodes;
              d["local_match_failures"] = st.local_match_failures;
+             d["innovation_rms"] = st.innovation_rms;
+             d["prior_weight"] = st.prior_weight;
              d["loop_attempts"] = st.loop_attempts;
              d["loop_closures"] = st.loop_closures;
              d["loop_rejected_ambiguous"] = st.loop_rejected_ambiguous;

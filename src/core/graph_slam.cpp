@@ -45,6 +45,7 @@ void GraphSlamParams::validate() const {
   if (!(local_min_score >= 0.0 && local_min_score <= 1.0)) throw std::invalid_argument("local_min_score must lie in [0, 1]");
   if (!(local_prior_margin >= 0.0 && local_prior_margin < 1.0)) throw std::invalid_argument("local_prior_margin must lie in [0, 1)");
   if (!(local_prior_weight >= 0.0)) throw std::invalid_argument("local_prior_weight must be >= 0");
+  if (!(local_prior_points >= 0.0)) throw std::invalid_argument("local_prior_points must be >= 0");
   at_least(submap_nodes, 1, "submap_nodes");
   positive(loop_search_radius, "loop_search_radius");
   if (!(loop_search_growth >= 0.0)) throw std::invalid_argument("loop_search_growth must be >= 0");
@@ -292,11 +293,28 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     ++stats_.local_match_failures;
     return predicted;
   }
+  // How far the scan moves odometry's prediction, over the last few hundred scans: small where
+  // odometry is good (the simulator: 3 mm a scan), large where it slips (the Radish logs: 28-33 mm).
+  const double innovation2 = (refined.head<2>() - predicted.head<2>()).squaredNorm();
+  double prior_weight = params_.local_prior_weight;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    innovation2_ = innovations_ == 0 ? innovation2 : innovation2_ + (innovation2 - innovation2_) / kInnovationWindow;
+    ++innovations_;
+    if (params_.local_prior_points > 0.0 && innovations_ >= kInnovationWarmup) {
+      // Never below the configured weight: where the scan leaves a direction open (a corridor
+      // without features) the best match along it is any, and the innovation says nothing of odometry.
+      prior_weight = std::clamp(1.0 / (2.0 * params_.local_prior_points * std::max(innovation2_, 1e-8)),
+                                params_.local_prior_weight, std::max(params_.local_prior_weight, kMaxPriorWeight));
+    }
+    stats_.prior_weight = prior_weight;
+    stats_.innovation_rms = std::sqrt(innovation2_);
+  }
   if (params_.local_prior_margin > 0.0) {
     // The local optimum nearest the prediction, if nearly as good: odometry decides what the scan
     // leaves open, the scan what it fixes (the climb follows every slope the scan has).
     double near_score = 0.0;
-    const Eigen::Vector3d near = refineMatch(grid, points, predicted, 0.005, 4, &near_score, params_.local_prior_weight);
+    const Eigen::Vector3d near = refineMatch(grid, points, predicted, 0.005, 4, &near_score, prior_weight);
     if (near_score >= (1.0 - params_.local_prior_margin) * score &&
         (near.head<2>() - predicted.head<2>()).cwiseAbs().maxCoeff() <= params_.local_search_window &&
         std::abs(normalizeAngle(near.z() - predicted.z())) <= params_.local_search_angle) {

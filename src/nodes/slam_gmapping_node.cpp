@@ -143,6 +143,7 @@ class SlamGmappingNode {
     param("local_min_score", g.local_min_score);
     param("local_prior_margin", g.local_prior_margin);
     param("local_prior_weight", g.local_prior_weight);
+    param("local_prior_points", g.local_prior_points);
     param("local_visible_only", g.local_visible_only);
     param("submap_nodes", g.submap_nodes);
     param("loop_search_radius", g.loop_search_radius);

@@ -109,6 +109,52 @@ def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
     assert os.path.exists(out + '.pgm') and os.path.exists(out + '.yaml')
 
 
+def test_a_bag_recorded_live_gives_each_scan_the_odometry_at_its_stamp(tmp_path):
+    """rosbag record writes messages as they arrive: a scan may come before the odometry of its
+    own time, or long after it. Each scan gets the odometry interpolated at its stamp; scans
+    outside the odometry's span are left out."""
+    import rosbag
+    import rospy
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import LaserScan
+
+    from mbot_slam_navigation.slam.offline import read_rosbag
+    from mbot_slam_navigation.transforms import yaw_to_quaternion
+
+    def odom_at(t):  # 0.3 m/s along x, turning at 0.2 rad/s (yaw wraps past pi at the end)
+        return 0.3 * t, 0.0, math.remainder(2.9 + 0.2 * t, 2 * math.pi)
+
+    rng = np.random.default_rng(3)
+    messages = []
+    for k in range(200):  # odometry at 50 Hz over 4 s
+        t = 0.02 * k
+        msg = Odometry()
+        msg.header.stamp = rospy.Time.from_sec(t)
+        x, y, yaw = odom_at(t)
+        msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+        (msg.pose.pose.orientation.x, msg.pose.pose.orientation.y, msg.pose.pose.orientation.z,
+         msg.pose.pose.orientation.w) = yaw_to_quaternion(yaw)
+        messages.append(('/odom', msg, t))
+    for k in range(45):  # scans at 10 Hz from 0.005 s to 4.405 s, the last 5 after the odometry ends
+        t = 0.005 + 0.1 * k
+        msg = LaserScan()
+        msg.header.stamp = rospy.Time.from_sec(t)
+        msg.angle_min, msg.angle_increment, msg.range_max = -math.pi, math.pi / 180, 10.0
+        msg.ranges = [1.0] * 360
+        # recorded up to 0.4 s early or late, as a busy machine's rosbag record does
+        messages.append(('/scan', msg, t + rng.uniform(-0.4, 0.4)))
+    path = str(tmp_path / 'live.bag')
+    with rosbag.Bag(path, 'w') as bag:
+        for topic, msg, t in sorted(messages, key=lambda m: m[2]):
+            bag.write(topic, msg, rospy.Time.from_sec(max(t, 0.001)))
+    scans = read_rosbag(path)
+    assert [round(s.time, 3) for s in scans] == [round(0.005 + 0.1 * k, 3) for k in range(40)]
+    for s in scans:
+        x, y, yaw = odom_at(s.time)
+        assert s.odom[0] == pytest.approx(x, abs=1e-6) and s.odom[1] == pytest.approx(y, abs=1e-6)
+        assert abs(math.remainder(s.odom[2] - yaw, 2 * math.pi)) < 1e-6
+
+
 def test_slam_offline_names_an_unknown_parameter_of_the_backend(tmp_path, capsys):
     """`particles` belongs to the particle filter: the graph backend refuses it by name."""
     from mbot_slam_navigation.slam.offline import main

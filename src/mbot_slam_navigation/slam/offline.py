@@ -17,7 +17,7 @@ from mbot_slam_navigation.maps.map_io import save_map
 from mbot_slam_navigation.slam.carmen import read_log
 from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, make_slam
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
-from mbot_slam_navigation.transforms import compose2d, quaternion_to_yaw, relative2d
+from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw, relative2d
 
 
 def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
@@ -42,19 +42,39 @@ def estimated_poses(slam, scans) -> np.ndarray:
 
 
 def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
-    """Scans from a bag with their odometry (nearest odom message at or before each scan)."""
+    """Scans from a bag with their odometry at each scan's stamp, interpolated between the odom
+    messages either side of it (by their stamps, not the order the bag holds them in: a bag
+    recorded live holds them up to several tenths of a second out of order). Scans outside the
+    odometry's span, or in a gap of it longer than 0.5 s, are left out."""
     import rosbag  # only needed for bags
     from mbot_slam_navigation.slam.carmen import Scan
-    scans, odom = [], None
+    odom, raw = [], []
     with rosbag.Bag(path) as bag:
         for topic, msg, _ in bag.read_messages(topics=[scan_topic, odom_topic]):
             if topic == odom_topic:
-                q = msg.pose.pose.orientation
-                odom = (msg.pose.pose.position.x, msg.pose.pose.position.y, quaternion_to_yaw(q.x, q.y, q.z, q.w))
-            elif odom is not None:
-                scans.append(Scan(time=msg.header.stamp.to_sec(), odom=odom, laser_pose=(0.0, 0.0, 0.0),
-                                  angle_min=msg.angle_min, angle_increment=msg.angle_increment,
-                                  ranges=np.asarray(msg.ranges, np.float32)))
+                p = msg.pose.pose
+                odom.append((msg.header.stamp.to_sec(), p.position.x, p.position.y,
+                             quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)))
+            else:
+                raw.append(msg)
+    if not odom:
+        return []
+    odom = np.array(sorted(odom))
+    times = odom[:, 0]
+    scans = []
+    for msg in sorted(raw, key=lambda m: m.header.stamp.to_sec()):
+        t = msg.header.stamp.to_sec()
+        k = int(np.searchsorted(times, t, side='right'))
+        if k == 0 or (k == len(times) and t > times[-1]):
+            continue
+        k = min(k, len(times) - 1)
+        a, b = odom[k - 1], odom[k]
+        if b[0] - a[0] > 0.5:
+            continue
+        w = 0.0 if b[0] <= a[0] else min(1.0, (t - a[0]) / (b[0] - a[0]))
+        pose = (a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]), normalize_angle(a[3] + w * normalize_angle(b[3] - a[3])))
+        scans.append(Scan(time=t, odom=pose, laser_pose=(0.0, 0.0, 0.0), angle_min=msg.angle_min,
+                          angle_increment=msg.angle_increment, ranges=np.asarray(msg.ranges, np.float32)))
     return scans
 
 
