@@ -287,9 +287,11 @@ class SlamGmappingNode {
     struct mallinfo2 heap = mallinfo2();
     ROS_INFO("slam_gmapping: %d nodes (%d revisits, %d of them with their scan freed, %d out of the optimization), "
              "%d submaps (%.1f MB), %d loop closures (%d in the graph), %d optimizations (last %.0f ms); "
+             "scans move odometry's prediction by %.1f mm (rms), so its prior weighs %.0f; "
              "heap %.1f MB in use, %.1f MB free",
              s.nodes, s.redundant_nodes, s.trimmed_nodes, s.merged_nodes, s.submaps, s.submap_bytes / 1e6,
              s.closures_accepted, s.loop_closures, s.optimizations, s.last_optimization_ms,
+             1000.0 * s.innovation_rms, s.prior_weight,
              (heap.uordblks + heap.hblkhd) / 1e6, heap.fordblks / 1e6);
   }
 
