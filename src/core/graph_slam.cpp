@@ -299,7 +299,9 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
   double prior_weight = params_.local_prior_weight;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    innovation2_ = innovations_ == 0 ? innovation2 : innovation2_ + (innovation2 - innovation2_) / kInnovationWindow;
+    // The plain mean until kInnovationWindow scans, then a running one over about that many (a
+    // running mean from the first scan on would still be mostly that scan's at the warm-up's end).
+    innovation2_ += (innovation2 - innovation2_) / std::min<double>(innovations_ + 1, kInnovationWindow);
     ++innovations_;
     if (params_.local_prior_points > 0.0 && innovations_ >= kInnovationWarmup) {
       // Never below the configured weight: where the scan leaves a direction open (a corridor

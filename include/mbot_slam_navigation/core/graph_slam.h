@@ -92,13 +92,13 @@ struct GraphSlamParams {
   /// (`~local_prior_weight`), while local_prior_points is 0 or fewer than 50 scans were tracked.
   double local_prior_weight = 5.0;
   /// How much odometry's prediction weighs against the scan, from how good odometry has been
-  /// (`~local_prior_points`): the climb's weight is 1 / (2 N r^2), r the root mean square of how far
-  /// the best match moved the prediction over the last 200 scans, N this value (the score counted
-  /// as N independent returns), kept within [local_prior_weight, 5000]. Where odometry is good the prior holds
-  /// what the scan says little and with bias (along a corridor: an office run's 25 m corridor came
-  /// out 0.6% short with the fixed 5.0; the simulator's r is 3 mm, a weight near 350); where it
-  /// slips (the Radish logs' r of 28-33 mm) the weight stays near 5, the value tuned on them (N
-  /// is 130 for that). 0 keeps local_prior_weight throughout.
+  /// (`~local_prior_points`): the climb's weight is 1 / (2 N r^2), r the root mean square of how
+  /// far the best match moved the prediction over the last 200 scans, N this value (the score
+  /// counted as N independent returns), kept within [local_prior_weight, 5000]. Where odometry is
+  /// good the prior holds what the scan says little of, and with bias (along a corridor: an office
+  /// run's 25 m corridor came out 0.6% short with the fixed 5.0; the simulator's r is 3-4 mm, a
+  /// weight of 200-350); where it slips (the Radish logs' r of 23-33 mm) the weight stays near 5,
+  /// the value tuned on them (N is 130 for that). 0 keeps local_prior_weight throughout.
   double local_prior_points = 130.0;
   /// Track a scan only with the returns that the local map's scans could have seen (Visibility in
   /// correlative_matcher.h; `~local_visible_only`): the others, what came into view as the robot
