@@ -57,24 +57,22 @@ def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
                              quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)))
             else:
                 raw.append(msg)
-    if not odom:
+    if not odom or not raw:
         return []
     odom = np.array(sorted(odom))
     times = odom[:, 0]
+    raw.sort(key=lambda m: m.header.stamp.to_sec())
+    stamps = np.array([m.header.stamp.to_sec() for m in raw])
+    after = np.minimum(np.searchsorted(times, stamps, side='right'), len(times) - 1)
+    usable = (stamps >= times[0]) & (stamps <= times[-1]) & (times[after] - times[np.maximum(after - 1, 0)] <= 0.5)
+    x, y = np.interp(stamps, times, odom[:, 1]), np.interp(stamps, times, odom[:, 2])
+    yaw = np.interp(stamps, times, np.unwrap(odom[:, 3]))  # along the shorter arc between samples
     scans = []
-    for msg in sorted(raw, key=lambda m: m.header.stamp.to_sec()):
-        t = msg.header.stamp.to_sec()
-        k = int(np.searchsorted(times, t, side='right'))
-        if k == 0 or (k == len(times) and t > times[-1]):
-            continue
-        k = min(k, len(times) - 1)
-        a, b = odom[k - 1], odom[k]
-        if b[0] - a[0] > 0.5:
-            continue
-        w = 0.0 if b[0] <= a[0] else min(1.0, (t - a[0]) / (b[0] - a[0]))
-        pose = (a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]), normalize_angle(a[3] + w * normalize_angle(b[3] - a[3])))
-        scans.append(Scan(time=t, odom=pose, laser_pose=(0.0, 0.0, 0.0), angle_min=msg.angle_min,
-                          angle_increment=msg.angle_increment, ranges=np.asarray(msg.ranges, np.float32)))
+    for i in np.flatnonzero(usable):
+        msg = raw[i]
+        scans.append(Scan(time=stamps[i], odom=(x[i], y[i], normalize_angle(yaw[i])), laser_pose=(0.0, 0.0, 0.0),
+                          angle_min=msg.angle_min, angle_increment=msg.angle_increment,
+                          ranges=np.asarray(msg.ranges, np.float32)))
     return scans
 
 
