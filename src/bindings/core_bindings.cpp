@@ -432,6 +432,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("match_sigma", &GraphSlamParams::match_sigma)
       .def_readwrite("local_map_nodes", &GraphSlamParams::local_map_nodes)
       .def_readwrite("local_search_window", &GraphSlamParams::local_search_window)
+      .def_readwrite("local_search_sigmas", &GraphSlamParams::local_search_sigmas)
+      .def_readwrite("local_search_max_window", &GraphSlamParams::local_search_max_window)
       .def_readwrite("local_search_angle", &GraphSlamParams::local_search_angle)
       .def_readwrite("local_min_score", &GraphSlamParams::local_min_score)
       .def_readwrite("local_prior_margin", &GraphSlamParams::local_prior_margin)
@@ -469,6 +471,7 @@ PYBIND11_MODULE(_core, m) {
              d["local_match_failures"] = st.local_match_failures;
              d["innovation_rms"] = st.innovation_rms;
              d["prior_weight"] = st.prior_weight;
+             d["search_window_m"] = st.search_window_m;
              d["loop_attempts"] = st.loop_attempts;
              d["loop_closures"] = st.loop_closures;
              d["loop_rejected_ambiguous"] = st.loop_rejected_ambiguous;

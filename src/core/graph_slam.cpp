@@ -41,6 +41,9 @@ void GraphSlamParams::validate() const {
   positive(match_sigma, "match_sigma");
   at_least(local_map_nodes, 1, "local_map_nodes");
   if (!(local_search_window >= 0.0)) throw std::invalid_argument("local_search_window must be >= 0");
+  if (!(local_search_sigmas >= 0.0)) throw std::invalid_argument("local_search_sigmas must be >= 0");
+  if (!(local_search_max_window >= local_search_window))
+    throw std::invalid_argument("local_search_max_window must be >= local_search_window");
   if (!(local_search_angle >= 0.0)) throw std::invalid_argument("local_search_angle must be >= 0");
   if (!(local_min_score >= 0.0 && local_min_score <= 1.0)) throw std::invalid_argument("local_min_score must lie in [0, 1]");
   if (!(local_prior_margin >= 0.0 && local_prior_margin < 1.0)) throw std::invalid_argument("local_prior_margin must lie in [0, 1)");
@@ -68,6 +71,7 @@ GraphSlam::GraphSlam(const GraphSlamParams& params)
     : params_((params.validate(), params)),
       registrar_(params.matcher, params.delta),
       map_({params.xmin, params.ymin}, {params.xmax, params.ymax}, params.delta) {
+  search_window_ = params_.local_search_window;
   if (params_.background) {
     worker_ = std::thread([this] { backgroundLoop(); });
 #ifdef __linux__
@@ -120,7 +124,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
     // returns (the far end of a corridor's walls, coming into range as the robot drives on) pull
     // the match back towards where the map ends. Never less than half the reach (a long
     // linearUpdate with a short laser would leave nothing to match).
-    const double gate = std::max(0.5 * reach, reach - since_node.head<2>().norm() - params_.local_search_window);
+    const double gate = std::max(0.5 * reach, reach - since_node.head<2>().norm() - search_window_);
     const Eigen::Vector2d laser = params_.matcher.laser_pose.head<2>();
     const Eigen::Vector3d predicted = composePose(track_pose_, relativePose(track_odom_, odom));
     std::vector<Eigen::Vector2d> near;
@@ -277,8 +281,8 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     return predicted;
   }
   const LikelihoodGrid& grid = *local_map_;
-  const MatchResult coarse = matchBranchAndBound(grid, points, predicted,
-                                                 {params_.local_search_window, params_.local_search_angle}, 0.0);
+  const double window = search_window_;  // this thread alone writes it
+  const MatchResult coarse = matchBranchAndBound(grid, points, predicted, {window, params_.local_search_angle}, 0.0);
   double score = 0.0;
   Eigen::Vector3d refined = coarse.found ? refineMatch(grid, points, coarse.pose, 0.005, 4, &score) : predicted;
   // Refinement only polishes the search's answer; a climb far beyond the window follows a slope
@@ -311,6 +315,11 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     }
     stats_.prior_weight = prior_weight;
     stats_.innovation_rms = std::sqrt(innovation2_);
+    if (params_.local_search_sigmas > 0.0 && innovations_ >= kInnovationWarmup) {
+      search_window_ = std::clamp(params_.local_search_sigmas * stats_.innovation_rms, params_.local_search_window,
+                                  params_.local_search_max_window);
+    }
+    stats_.search_window_m = search_window_;
   }
   if (params_.local_prior_margin > 0.0) {
     // The local optimum nearest the prediction, if nearly as good: odometry decides what the scan
@@ -318,7 +327,7 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     double near_score = 0.0;
     const Eigen::Vector3d near = refineMatch(grid, points, predicted, 0.005, 4, &near_score, prior_weight);
     if (near_score >= (1.0 - params_.local_prior_margin) * score &&
-        (near.head<2>() - predicted.head<2>()).cwiseAbs().maxCoeff() <= params_.local_search_window &&
+        (near.head<2>() - predicted.head<2>()).cwiseAbs().maxCoeff() <= window &&
         std::abs(normalizeAngle(near.z() - predicted.z())) <= params_.local_search_angle) {
       return near;
     }

@@ -139,6 +139,8 @@ class SlamGmappingNode {
     param("match_sigma", g.match_sigma);
     param("local_map_nodes", g.local_map_nodes);
     param("local_search_window", g.local_search_window);
+    param("local_search_sigmas", g.local_search_sigmas);
+    param("local_search_max_window", g.local_search_max_window);
     param("local_search_angle", g.local_search_angle);
     param("local_min_score", g.local_min_score);
     param("local_prior_margin", g.local_prior_margin);
@@ -287,11 +289,12 @@ class SlamGmappingNode {
     struct mallinfo2 heap = mallinfo2();
     ROS_INFO("slam_gmapping: %d nodes (%d revisits, %d of them with their scan freed, %d out of the optimization), "
              "%d submaps (%.1f MB), %d loop closures (%d in the graph), %d optimizations (last %.0f ms); "
-             "scans move odometry's prediction by %.1f mm (rms), so its prior weighs %.0f; "
+             "scans move odometry's prediction by %.1f mm (rms), so its prior weighs %.0f and the search window is "
+             "+-%.2f m; "
              "heap %.1f MB in use, %.1f MB free",
              s.nodes, s.redundant_nodes, s.trimmed_nodes, s.merged_nodes, s.submaps, s.submap_bytes / 1e6,
              s.closures_accepted, s.loop_closures, s.optimizations, s.last_optimization_ms,
-             1000.0 * s.innovation_rms, s.prior_weight,
+             1000.0 * s.innovation_rms, s.prior_weight, s.search_window_m,
              (heap.uordblks + heap.hblkhd) / 1e6, heap.fordblks / 1e6);
   }
 
