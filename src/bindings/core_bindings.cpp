@@ -1,6 +1,8 @@
 // The one pybind11 module over the C++ core. Bound names are private (leading underscore); the
 // typed wrappers in src/mbot_slam_navigation/ are what Python code imports. Conversions to and from
 // numpy happen here, at the boundary, and nowhere else.
+#include <tuple>
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -447,6 +449,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("loop_search_angle", &GraphSlamParams::loop_search_angle)
       .def_readwrite("loop_min_response", &GraphSlamParams::loop_min_response)
       .def_readwrite("loop_ambiguity", &GraphSlamParams::loop_ambiguity)
+      .def_readwrite("loop_sigma_distance", &GraphSlamParams::loop_sigma_distance)
       .def_readwrite("loop_candidates", &GraphSlamParams::loop_candidates)
       .def_readwrite("loop_reject_chi2", &GraphSlamParams::loop_reject_chi2)
       .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)
@@ -497,6 +500,15 @@ PYBIND11_MODULE(_core, m) {
              for (std::size_t i = 0; i < poses.size(); ++i) {
                o(i, 0) = poses[i].first;
                for (int k = 0; k < 3; ++k) o(i, 1 + k) = poses[i].second[k];
+             }
+             return out;
+           })
+      .def("edges",
+           [](const GraphSlam& s) {
+             // (from, to, x, y, theta, is_closure): every edge's measurement, the pose of `to` in `from`'s frame
+             std::vector<std::tuple<int, int, double, double, double, bool>> out;
+             for (const auto& e : s.edges()) {
+               out.emplace_back(e.from, e.to, e.measurement.x(), e.measurement.y(), e.measurement.z(), e.robust);
              }
              return out;
            })

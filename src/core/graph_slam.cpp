@@ -56,6 +56,7 @@ void GraphSlamParams::validate() const {
   if (!(loop_search_angle >= 0.0)) throw std::invalid_argument("loop_search_angle must be >= 0");
   if (!(loop_min_response > 0.0 && loop_min_response <= 1.0)) throw std::invalid_argument("loop_min_response must lie in (0, 1]");
   if (!(loop_ambiguity > 0.0 && loop_ambiguity <= 1.0)) throw std::invalid_argument("loop_ambiguity must lie in (0, 1]");
+  if (!(loop_sigma_distance >= 0.0)) throw std::invalid_argument("loop_sigma_distance must be >= 0");
   at_least(loop_candidates, 0, "loop_candidates");
   positive(loop_reject_chi2, "loop_reject_chi2");
   positive(edge_sigma_xy, "edge_sigma_xy");
@@ -484,7 +485,22 @@ bool GraphSlam::searchClosures(int n) {
       ++stats_.loop_rejected_ambiguous;
       continue;
     }
-    edges_.push_back({c.anchor_index, n, refined, edgeInformation(1.0), true});
+    // A scan matched from farther off the submap's nodes sees less of what they saw, and the part it
+    // shares lies on the submap's side: such closures put the node nearer the submap than it is
+    // (an office run's closures from 1-2 m off were 2.5 cm short on average, from within 0.5 m
+    // 0.04 cm), and hundreds of them shrank the map by 0.6%. They weigh less, not nothing: in
+    // halls the robot seldom passes within 1 m of where it was.
+    double scale = 1.0;
+    if (params_.loop_sigma_distance > 0.0) {
+      const Eigen::Vector3d& anchor = nodes_[c.anchor_index].pose;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int k = c.anchor_index; k < c.anchor_index + params_.submap_nodes && k < static_cast<int>(nodes_.size()); ++k) {
+        nearest = std::min(nearest, (relativePose(anchor, nodes_[k].pose).head<2>() - refined.head<2>()).norm());
+      }
+      const double q = nearest / params_.loop_sigma_distance;
+      scale = std::sqrt(1.0 + q * q);
+    }
+    edges_.push_back({c.anchor_index, n, refined, edgeInformation(scale), true});
     ++stats_.closures_accepted;
     last_closure_travelled_ = travelled;
     const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);

@@ -154,6 +154,7 @@ class SlamGmappingNode {
     param("loop_search_angle", g.loop_search_angle);
     param("loop_min_response", g.loop_min_response);
     param("loop_ambiguity", g.loop_ambiguity);
+    param("loop_sigma_distance", g.loop_sigma_distance);
     param("loop_candidates", g.loop_candidates);
     param("redundant_distance", g.redundant_distance);
     param("redundant_angle", g.redundant_angle);

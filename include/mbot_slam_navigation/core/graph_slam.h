@@ -123,6 +123,12 @@ struct GraphSlamParams {
   double loop_min_response = 0.55;  ///< mean likelihood a closure must reach (`~loop_min_response`)
   double loop_ambiguity = 0.9;      ///< a second pose scoring this share of the best rejects it (`~loop_ambiguity`)
   int loop_candidates = 3;          ///< nearest submaps tried per node (`~loop_candidates`)
+  /// [m] A closure's standard deviations grow with d, the distance from the matched pose to the
+  /// nearest node of the submap, as sqrt(1 + (d / this)^2) (`~loop_sigma_distance`): a scan taken
+  /// farther off sees less of what the submap saw, and the match leans towards it (an office run's
+  /// closures from 1-2 m off were 2.5 cm short on average, from within 0.5 m 0.04 cm; at equal
+  /// weight they shrank its map by 0.6%). 0: every closure weighs as a chain edge.
+  double loop_sigma_distance = 0.25;
   double loop_reject_chi2 = 50.0;   ///< closures above this error after optimizing are removed
   double edge_sigma_xy = 0.03;      ///< [m] standard deviation of an edge's translation
   double edge_sigma_theta = 0.01;   ///< [rad] and of its rotation
