@@ -175,6 +175,20 @@ def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
     assert p.match_sigma == GRAPH_DEFAULTS['match_sigma'] and not p.background
     with pytest.raises(ValueError, match='loop_min_response'):
         make_graph_params({'loop_min_response': 2.0})
+    with pytest.raises(ValueError, match='local_search_max_window'):
+        make_graph_params({'local_search_max_window': 0.1})  # below local_search_window
+    assert make_graph_params({'keep_trimmed_scans': 1}).keep_trimmed_scans is True
+
+
+def test_graph_defaults_in_python_are_the_cores():
+    # Declared twice (graph_slam.h for the node, backends.py for slam_offline and the benches):
+    # a default changed in one place only would make offline figures of another configuration.
+    from mbot_slam_navigation import _core
+    from mbot_slam_navigation.slam.backends import COMMON_DEFAULTS, GRAPH_DEFAULTS
+    core = _core._GraphSlamParams()
+    for key, value in GRAPH_DEFAULTS.items():
+        if key not in COMMON_DEFAULTS:
+            assert getattr(core, key) == pytest.approx(value), key
 
 
 def test_a_carmen_log_becomes_a_bag_that_slam_can_play(tmp_path):
