@@ -2,8 +2,8 @@
 // Cartographer:
 //
 // Local SLAM. Every scan is tracked: its pose, predicted by odometry from the previous scan's, is
-// corrected by correlative matching (branch and bound over a small window, then refinement; see
-// correlative_matcher.h) against a likelihood grid of the last `local_map_nodes` nodes' scans.
+// corrected by correlative matching (branch and bound over a window as wide as odometry's record
+// asks, local_search_sigmas, then refinement; see correlative_matcher.h) against a likelihood grid of the last `local_map_nodes` nodes' scans.
 // Every linearUpdate metres, angularUpdate radians or temporalUpdate seconds of odometry the
 // tracked scan becomes a node, joined by an edge to the previous node, and the local map is rebuilt.
 //
@@ -14,7 +14,9 @@
 // loop_search_max_radius, and the window of the branch-and-bound search is that radius. A match
 // becomes an edge (anchor -> node) only if its response reaches loop_min_response and it is not
 // ambiguous: no other pose at least 0.3 m or 0.1 rad away scores within loop_ambiguity of it
-// (a corridor, a row of doors).
+// (a corridor, a row of doors). It weighs less the farther from the submap's nodes the scan was
+// matched (loop_sigma_distance): such a scan shares with them only what lies on their side, and
+// its match leans that way.
 //
 // Optimization. After new closures the graph is solved (pose_graph.h) unless every new closure
 // agrees with the current estimate (error below loop_solve_chi2; a robot revisiting a well-mapped
