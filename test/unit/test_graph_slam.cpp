@@ -533,7 +533,7 @@ TEST(GraphSlam, TheTrackingWindowWidensForOdometryThatSlipsAndStaysNarrowForGood
   std::printf("window %.3f m with exact odometry, %.3f m with slipping odometry; worst step tracked %.3f m off "
               "(fixed window: %.3f m; exact odometry: %.3f m)\n", window_exact, window, worst, worst_fixed, worst_exact);
   EXPECT_DOUBLE_EQ(window_exact, GraphSlamParams().local_search_window) << "good odometry keeps the narrow window";
-  EXPECT_GE(window, 0.25) << "odometry that slips by up to 0.22 m a scan needs a window they fit in";
+  EXPECT_GE(window, 0.25) << "odometry that slips by up to 0.28 m a scan needs a window its slips fit in";
   EXPECT_LE(window, GraphSlamParams().local_search_max_window);
   EXPECT_DOUBLE_EQ(window_fixed, GraphSlamParams().local_search_window);
   // Measured: 0.026 m widening, 0.169 m fixed, 0.006 m with exact odometry.
