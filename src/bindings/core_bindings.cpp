@@ -511,15 +511,7 @@ PYBIND11_MODULE(_core, m) {
                out.emplace_back(e.from, e.to, e.measurement.x(), e.measurement.y(), e.measurement.z(), e.robust);
              }
              return out;
-           })
-      .def("closures", [](const GraphSlam& s) {
-        // (from, to) node indices of the loop-closure edges
-        std::vector<std::pair<int, int>> out;
-        for (const auto& e : s.edges()) {
-          if (e.robust) out.emplace_back(e.from, e.to);
-        }
-        return out;
-      });
+           });
 
   // --- Costmaps ----------------------------------------------------------------------------------
   m.def(

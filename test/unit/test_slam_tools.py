@@ -180,6 +180,18 @@ def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
     assert make_graph_params({'keep_trimmed_scans': 1}).keep_trimmed_scans is True
 
 
+def test_the_graph_lists_its_chain_edges_as_the_relative_poses_of_its_nodes():
+    from mbot_slam_navigation.slam.offline import run
+    slam, _ = run(read_log(os.path.join(DATA, 'tiny.clf')), {'linearUpdate': 0.2, 'angularUpdate': 0.2},
+                  progress=False, backend='graph')
+    nodes, edges = slam.trajectory(), slam.edges()
+    assert [(f, t) for f, t, *_ in edges] == [(k, k + 1) for k in range(len(nodes) - 1)]
+    for f, t, x, y, theta, closure in edges:  # no closure in 3 scans: nothing moved the chain
+        assert not closure
+        assert np.allclose(relative2d(nodes[f, 1:4], nodes[t, 1:4]), (x, y, theta), atol=1e-9)
+    assert slam.closures() == []
+
+
 def test_graph_defaults_in_python_are_the_cores():
     # Declared twice (graph_slam.h for the node, backends.py for slam_offline and the benches):
     # a default changed in one place only would make offline figures of another configuration.

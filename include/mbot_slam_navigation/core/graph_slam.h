@@ -3,7 +3,8 @@
 //
 // Local SLAM. Every scan is tracked: its pose, predicted by odometry from the previous scan's, is
 // corrected by correlative matching (branch and bound over a window as wide as odometry's record
-// asks, local_search_sigmas, then refinement; see correlative_matcher.h) against a likelihood grid of the last `local_map_nodes` nodes' scans.
+// asks, local_search_sigmas, then refinement; see correlative_matcher.h) against a likelihood grid
+// of the last `local_map_nodes` nodes' scans.
 // Every linearUpdate metres, angularUpdate radians or temporalUpdate seconds of odometry the
 // tracked scan becomes a node, joined by an edge to the previous node, and the local map is rebuilt.
 //

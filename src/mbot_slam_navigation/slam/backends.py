@@ -159,9 +159,14 @@ class GraphSlam(_Backend):
     def stats(self) -> dict:
         return self._impl.stats()
 
+    def edges(self):
+        """[(from, to, x, y, theta, is_closure)]: every edge of the graph, its measurement the pose of
+        node `to` in node `from`'s frame ([m], [rad]); node indices as in trajectory()."""
+        return self._impl.edges()
+
     def closures(self):
         """(from, to) node indices of the accepted loop closures."""
-        return self._impl.closures()
+        return [(f, t) for f, t, _, _, _, closure in self.edges() if closure]
 
 
 def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
