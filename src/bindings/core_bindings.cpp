@@ -23,6 +23,7 @@
 #include "mbot_slam_navigation/core/occupancy_grid.h"
 #include "mbot_slam_navigation/core/path_lengths.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
+#include "mbot_slam_navigation/core/tour.h"
 #include "mbot_slam_navigation/core/world2d.h"
 
 namespace py = pybind11;
@@ -684,6 +685,22 @@ PYBIND11_MODULE(_core, m) {
         return out;
       },
       py::arg("passable"), py::arg("col"), py::arg("row"));
+  m.def(
+      "_shortest_paths_through_all",
+      [](py::array_t<double, py::array::c_style | py::array::forcecast> d, int exact_max) {
+        if (d.ndim() != 2 || d.shape(0) != d.shape(1)) {
+          throw std::invalid_argument("_shortest_paths_through_all: d must be an n x n array");
+        }
+        const int n = static_cast<int>(d.shape(0));
+        std::vector<double> m(d.data(), d.data() + d.size());
+        std::vector<double> rest;
+        {
+          py::gil_scoped_release release;
+          rest = mbot::core::shortestPathsThroughAll(m, n, exact_max);
+        }
+        return py::array_t<double>(n, rest.data());
+      },
+      py::arg("d"), py::arg("exact_max") = 12);
   m.def("_circumscribed_radius", &mbot::core::circumscribedRadius, py::arg("footprint"));
   m.def("_validate_footprint", &mbot::core::validateFootprint, py::arg("footprint"));
 

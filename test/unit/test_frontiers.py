@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mbot_slam_navigation import _core
-from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, Teammate, frontier_groups,
+from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, GoalFields, Grid, Teammate, frontier_groups,
                                                 rank_frontiers, share_out, tour_order, yields_goal)
 
 RES = 0.05
@@ -387,6 +387,48 @@ def test_the_tour_finishes_the_dead_end_side_before_crossing_to_the_other():
     # one frontier, or tours switched off: unchanged
     assert tour_order([west], passable, grid) == [west]
     assert tour_order(greedy, passable, grid, size=0) == greedy
+
+
+def test_the_tour_takes_a_small_frontier_behind_the_robot_before_twelve_larger_ones_ahead():
+    # The office's long trips: the tour saw only the 8 best by greedy cost, so a small frontier
+    # the robot passed was left for last and the robot came back across the floor for it. Here a
+    # 0.8 m frontier 1.5 m behind the robot is the 12th best greedily; twelve 10 m ones lie 2-4.75 m
+    # ahead.
+    passable = np.zeros((20, 400), np.uint8)
+    passable[5:15, 5:395] = 1
+    grid = Grid(passable.astype(np.int8), RES, (0.0, 0.0))
+    behind = _frontier_at(3.5, 0.5, 1.5, size_m=0.8)
+    ahead = [_frontier_at(5.0 + d, 0.5, d, size_m=10.0) for d in np.arange(2.0, 4.76, 0.25)]
+    greedy = sorted([behind] + ahead, key=lambda f: f.cost)
+    assert [f.goal for f in greedy].index(behind.goal) == 11
+    assert tour_order([behind] + ahead, passable, grid)[0].goal == behind.goal
+    # the 8 best only: it is left behind
+    assert tour_order([behind] + ahead, passable, grid, size=8)[0].goal != behind.goal
+
+
+def test_goal_fields_are_reused_while_they_serve():
+    passable = np.zeros((20, 220), np.uint8)
+    passable[5:15, 5:215] = 1
+    grid = Grid(passable.astype(np.int8), RES, (0.0, 0.0))
+    frontiers = [_frontier_at(x, 0.5, abs(x - 5.0), size_m=1.0) for x in (2.0, 6.0, 9.0)]
+    fields = GoalFields(max_age=10.0, reuse_m=0.3)
+    first = tour_order(frontiers, passable, grid, fields=fields, now=0.0)
+    assert fields.computed == 3
+    # the same goals 3 s later, and one moved 0.2 m with its frontier: nothing new to compute,
+    # the same order as fresh fields give
+    moved = frontiers[:2] + [_frontier_at(9.2, 0.5, 4.2, size_m=1.0)]
+    again = tour_order(moved, passable, grid, fields=fields, now=3.0)
+    assert fields.computed == 3
+    assert [f.goal for f in again] == [f.goal for f in tour_order(moved, passable, grid)]
+    assert [f.goal for f in first][:2] == [f.goal for f in again][:2]
+    # a goal 1 m from any computed one gets its own field; after max_age all are computed anew
+    tour_order(frontiers[:2] + [_frontier_at(8.0, 0.5, 3.0, size_m=1.0)], passable, grid, fields=fields, now=4.0)
+    assert fields.computed == 4
+    tour_order(frontiers, passable, grid, fields=fields, now=15.0)
+    assert fields.computed == 7
+    # the clock went back (a simulation reset): nothing from before is used
+    tour_order(frontiers, passable, grid, fields=fields, now=1.0)
+    assert fields.computed == 10
 
 
 def test_a_team_shares_the_frontiers_out():

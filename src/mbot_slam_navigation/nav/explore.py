@@ -29,10 +29,11 @@ potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), m
 transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
 hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space
 smaller than this, the inside of furniture, makes no frontier unless free floor bounds most of it:
-then it is floor in a shadow), tour_frontiers (8: the frontiers re-ranked by the
-shortest tour through the goals of the 8 best, frontiers.tour_order, so that the robot finishes one
-side before it crosses to the other; 0 or 1: explore_lite's greedy choice; a team's robots choose
-greedily), return_to_start (true), report_dir (''), world_name ('' = the simulator's
+then it is floor in a shadow), tour_frontiers (20: the frontiers re-ranked by the
+shortest tour through the goals of the 20 best, frontiers.tour_order, so that the robot finishes one
+side before it crosses to the other, and takes a small frontier it passes rather than coming back
+for it; 0 or 1: explore_lite's greedy choice; a team's robots choose greedily), return_to_start
+(true), report_dir (''), world_name ('' = the simulator's
 /gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
 progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
 scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
@@ -76,8 +77,8 @@ from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
-from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, Grid, MotionWatch, Plateau,
-                                                Teammate, rank_frontiers, share_out, tour_order,
+from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, GoalFields, Grid, MotionWatch,
+                                                Plateau, Teammate, rank_frontiers, share_out, tour_order,
                                                 yields_goal)
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
@@ -127,10 +128,8 @@ class Explore:
             rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
         self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
         self.min_unknown_area = r.number('min_unknown_area', 3.0, minimum=0.0)
-        self.tour_frontiers = r.integer('tour_frontiers', 8, minimum=0)
-        if self.tour_frontiers > 12:
-            rospy.logwarn('explore: ~tour_frontiers %d: the tour costs 2^n steps; using 12' % self.tour_frontiers)
-            self.tour_frontiers = 12
+        self.tour_frontiers = r.integer('tour_frontiers', 20, minimum=0)
+        self.goal_fields = GoalFields()  # tour_order's path lengths, kept between cycles
         self.visualize = r.boolean('visualize', True)
         self.transform_tolerance = r.number('transform_tolerance', 0.3, positive=True)
         self.state = ExploreState(progress_timeout=r.number('progress_timeout', 30.0, positive=True),
@@ -435,7 +434,7 @@ class Explore:
                 frontiers, claimed = share_out(frontiers, mates, self.claim_radius, self.potential_scale)
             elif self.tour_frontiers >= 2 and 'passable' in stats:
                 frontiers = tour_order(frontiers, stats['passable'], costmap, self.potential_scale,
-                                       self.tour_frontiers)
+                                       self.tour_frontiers, fields=self.goal_fields, now=now)
             self.publish_markers(frontiers)
             self.plateau.update(now, explore_report.known_area(m), bool(frontiers) or self.state.goal is not None)
             new = self.state.choose(now, frontiers, pose[:2])
