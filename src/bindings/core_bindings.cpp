@@ -490,6 +490,7 @@ PYBIND11_MODULE(_core, m) {
              d["submap_bytes"] = st.submap_bytes;
              d["closures_accepted"] = st.closures_accepted;
              d["merged_nodes"] = st.merged_nodes;
+             d["closures_moved"] = st.closures_moved;
              d["closures_unsolved"] = st.closures_unsolved;
              return d;
            })

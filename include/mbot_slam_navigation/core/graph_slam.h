@@ -42,8 +42,10 @@
 // submap made mostly of redundant nodes is not kept. Match points are freed from every node at
 // that point. The trimmed node then leaves the
 // optimization too: its two chain edges become one (the measurements composed, the covariances
-// propagated) and its closures are dropped (they only tied a revisit to a map that other nodes
-// hold); it keeps its pose relative to the node before it, and moves with it. What is kept and
+// propagated) and its closures move to the live node before it (composed with the chain edge
+// between them; of several from one submap to that node, the least uncertain stays): they are
+// what ties a revisit, and so the loop it closes, to the map. It keeps its pose relative to the
+// node before it, and moves with it. What is kept and
 // solved then grows with the area seen, not with the time spent (a merged node's ~0.1 KB remains).
 //
 // Frames and units: as slam_backend.h.
@@ -165,7 +167,8 @@ struct GraphSlamStats {
   double prior_weight = 0.0;        ///< [1/m^2] the climb's weight at the last scan
   int loop_attempts = 0;            ///< submap matches tried
   int loop_closures = 0;            ///< closure edges in the graph
-  int closures_accepted = 0;        ///< closures ever accepted (some since dropped with merged nodes)
+  int closures_accepted = 0;        ///< closures ever accepted (some since merged into others)
+  int closures_moved = 0;           ///< closures moved from a merged node to the node before it
   int merged_nodes = 0;             ///< trimmed nodes taken out of the optimization
   int loop_rejected_ambiguous = 0;
   int loop_rejected_inconsistent = 0;  ///< removed after optimization
