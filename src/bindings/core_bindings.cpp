@@ -492,6 +492,8 @@ PYBIND11_MODULE(_core, m) {
              d["merged_nodes"] = st.merged_nodes;
              d["closures_moved"] = st.closures_moved;
              d["closures_unsolved"] = st.closures_unsolved;
+             d["closure_backlog"] = st.closure_backlog;
+             d["closure_backlog_max"] = st.closure_backlog_max;
              return d;
            })
       .def("scan_poses",

@@ -174,6 +174,10 @@ struct GraphSlamStats {
   int loop_rejected_inconsistent = 0;  ///< removed after optimization
   int optimizations = 0;
   int closures_unsolved = 0;        ///< closures that agreed with the estimate and await the next solve
+  /// Nodes waiting for the closure search now, and the most that ever waited (with `background`:
+  /// the closure thread's backlog, which grows when the machine cannot give it the time it needs).
+  int closure_backlog = 0;
+  int closure_backlog_max = 0;
   double last_optimization_ms = 0.0;
   double search_radius_m = 0.0;     ///< current loop search radius
   int redundant_nodes = 0;          ///< nodes found redundant (redundant_distance)
