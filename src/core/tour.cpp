@@ -116,7 +116,8 @@ std::vector<double> shortestPathsThroughAll(const std::vector<double>& d, int n,
     }
   }
   if (n == 0) return {};
-  if (n <= std::min(exact_max, 20)) return exactTours(d, n);
+  // Never exact beyond 16 goals, whatever exact_max says: the table is 2^n x n (8 MB at 16, 160 MB at 20).
+  if (n <= std::min(exact_max, 16)) return exactTours(d, n);
   std::vector<double> out(n);
   for (int i = 0; i < n; ++i) out[i] = heuristicTour(d, n, i);
   return out;

@@ -32,9 +32,9 @@ smaller than this, the inside of furniture, makes no frontier unless free floor 
 then it is floor in a shadow), tour_frontiers (20: the frontiers re-ranked by the
 shortest tour through the goals of the 20 best, frontiers.tour_order, so that the robot finishes one
 side before it crosses to the other, and takes a small frontier it passes rather than coming back
-for it; 0 or 1: explore_lite's greedy choice; a team's robots choose greedily), return_to_start
-(true), report_dir (''), world_name ('' = the simulator's
-/gazebo/world_name, for ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
+for it; at most 40; 0 or 1: explore_lite's greedy choice; a team's robots choose greedily),
+return_to_start (true), report_dir (''), world_name ('' = the simulator's /gazebo/world_name, for
+ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
 progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
 scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
 escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals sent within 0.6 m
@@ -92,6 +92,7 @@ BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot
 # this many times min_frontier_size: in the apartment the ones of 0.8-0.9 m were nooks that no
 # trip showed; the home's kitchen, seen only from its door, left one of 2.25 m.
 REVISIT_SIZE_FACTOR = 2.0
+MAX_TOUR_FRONTIERS = 40  # ~tour_frontiers above this is capped, with a warning (see Explore.__init__)
 
 
 def sim_sleep(seconds: float, poll: float = 0.02) -> None:
@@ -129,6 +130,12 @@ class Explore:
         self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
         self.min_unknown_area = r.number('min_unknown_area', 3.0, minimum=0.0)
         self.tour_frontiers = r.integer('tour_frontiers', 20, minimum=0)
+        if self.tour_frontiers > MAX_TOUR_FRONTIERS:
+            # a tour beyond 12 goals costs about n^4 steps and a path-length field per goal: 5 ms at
+            # 40, 24 ms at 60, seconds at a few hundred, every cycle
+            rospy.logwarn('explore: ~tour_frontiers %d: more than %d makes every cycle slow; using %d'
+                          % (self.tour_frontiers, MAX_TOUR_FRONTIERS, MAX_TOUR_FRONTIERS))
+            self.tour_frontiers = MAX_TOUR_FRONTIERS
         self.goal_fields = GoalFields()  # tour_order's path lengths, kept between cycles
         self.visualize = r.boolean('visualize', True)
         self.transform_tolerance = r.number('transform_tolerance', 0.3, positive=True)

@@ -262,7 +262,7 @@ class GoalFields:
         self.computed = 0  # fields computed so far (for tests and the log)
 
     @staticmethod
-    def _value(entry, x: float, y: float) -> float:
+    def length_at(entry, x: float, y: float) -> float:
         """[m] the path length the field gives at (x, y); -1 if it has none there."""
         _, lengths, (ox, oy), step = entry
         r, c = int(math.floor((y - oy) / step)), int(math.floor((x - ox) / step))
@@ -275,7 +275,7 @@ class GoalFields:
         self._fields = [e for e in self._fields if 0.0 <= now - e[0] < self.max_age]
         best, best_d = None, math.inf
         for e in self._fields:
-            v = self._value(e, goal[0], goal[1])
+            v = self.length_at(e, goal[0], goal[1])
             if 0.0 <= v <= self.reuse_m and v < best_d:
                 best, best_d = e, v
         return best
@@ -329,7 +329,7 @@ def tour_order(frontiers: List[Frontier], passable: np.ndarray, costmap: Grid, p
     d = np.zeros((k, k))
     for i in range(k):
         for j in range(i + 1, k):
-            values = [GoalFields._value(rows[a], head[z].goal[0], head[z].goal[1])
+            values = [GoalFields.length_at(rows[a], head[z].goal[0], head[z].goal[1])
                       for a, z in ((i, j), (j, i)) if rows[a] is not None]
             values = [v for v in values if v >= 0]
             # not connected on the coarse grid (a goal in a block of its own, a goal off this grid
