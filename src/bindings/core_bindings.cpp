@@ -433,6 +433,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("matcher", &GraphSlamParams::matcher)
       .def_readwrite("match_max_range", &GraphSlamParams::match_max_range)
       .def_readwrite("match_sigma", &GraphSlamParams::match_sigma)
+      .def_readwrite("local_match_sigma", &GraphSlamParams::local_match_sigma)
       .def_readwrite("local_map_nodes", &GraphSlamParams::local_map_nodes)
       .def_readwrite("local_search_window", &GraphSlamParams::local_search_window)
       .def_readwrite("local_search_sigmas", &GraphSlamParams::local_search_sigmas)

@@ -39,6 +39,7 @@ void GraphSlamParams::validate() const {
   if (!(xmax > xmin && ymax > ymin)) throw std::invalid_argument("xmax/ymax must exceed xmin/ymin");
   positive(match_max_range, "match_max_range");
   positive(match_sigma, "match_sigma");
+  if (!std::isfinite(local_match_sigma)) throw std::invalid_argument("local_match_sigma must be a number (<= 0: match_sigma)");
   at_least(local_map_nodes, 1, "local_map_nodes");
   if (!(local_search_window >= 0.0)) throw std::invalid_argument("local_search_window must be >= 0");
   if (!(local_search_sigmas >= 0.0)) throw std::invalid_argument("local_search_sigmas must be >= 0");
@@ -317,7 +318,7 @@ void GraphSlam::rebuildLocalMapLocked() {
   if (!all_scans) local_seen_.clear();
   // Under the lock with the node that it ends with, so that currentPose() never sees a new node
   // with the old anchor.
-  local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, params_.match_sigma);
+  local_map_ = std::make_unique<LikelihoodGrid>(reference, params_.delta, localSigma());
   local_anchor_ = track_pose_ = nodes_.back().pose;
   track_odom_ = nodes_.back().odom;
 }
@@ -704,6 +705,11 @@ GraphSlamStats GraphSlam::stats() const {
 std::vector<PoseGraphEdge> GraphSlam::edges() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return edges_;
+}
+
+bool GraphSlam::mapOutdated() const {
+  std::lock_guard<std::mutex> lock(map_mutex_);
+  return map_dirty_;
 }
 
 OccupancyImage GraphSlam::occupancy(double occ_thresh) const {

@@ -137,6 +137,7 @@ class SlamGmappingNode {
     auto& g = graph_params_;
     param("match_max_range", g.match_max_range);
     param("match_sigma", g.match_sigma);
+    param("local_match_sigma", g.local_match_sigma);
     param("local_map_nodes", g.local_map_nodes);
     param("local_search_window", g.local_search_window);
     param("local_search_sigmas", g.local_search_sigmas);
@@ -250,11 +251,15 @@ class SlamGmappingNode {
                params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
                base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
     }
-    bool updated, moved = false;
+    bool updated, moved = false, outdated = false;
     Eigen::Vector3d before, after;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
+      // A closure found for the last node is solved after it, in the graph's own thread: a robot
+      // that then stands still (an explorer back at its start) would keep the map of before the
+      // correction until it moved linearUpdate on, and its report would judge that map.
+      outdated = !updated && slam_->mapOutdated();
       // gmapping moves map -> odom at its updates only; the graph tracks every scan, and its
       // optimizer moves the current pose by exactly its correction, so map -> odom follows both.
       if (updated || backend_ == "graph") {
@@ -265,8 +270,9 @@ class SlamGmappingNode {
     }
     if (moved) publishScanTransform(msg->header.stamp, before, after, odom);
     beatHeartbeat(msg->header.stamp);
-    if (!updated) return;
-    if (const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get())) {
+    if (!updated && !outdated) return;
+    const auto* rbpf = dynamic_cast<const mbot::core::RbpfSlam*>(slam_.get());
+    if (updated && rbpf) {
       std_msgs::Float64 entropy;
       entropy.data = rbpf->poseEntropy();
       entropy_pub_.publish(entropy);
@@ -275,7 +281,7 @@ class SlamGmappingNode {
       publishMap(msg->header.stamp);
       last_map_update_ = msg->header.stamp;
     }
-    logSummary(msg->header.stamp);
+    if (updated) logSummary(msg->header.stamp);
   }
 
   // One line every kSummaryPeriod of (simulated) time: what the graph holds, so that a user who

@@ -152,6 +152,30 @@ TEST(GraphSlam, AnsweringInTheBackgroundGivesTheSameClosedLoop) {
   EXPECT_GE(slam.stats().loop_closures, 3);
 }
 
+// The node republishes the map when this says so, also while the robot stands still: a closure
+// solved after the last node (an explorer back at its start) must reach the map.
+TEST(GraphSlam, TheMapIsOutdatedOnlyAfterAnOptimizationMovedNodesSinceItWasDrawn) {
+  const World2D w = squareCorridor();
+  const Drive d = twoLaps();
+  GraphSlam slam(corridorParams());
+  std::mt19937 rng(7);
+  bool outdated_before_closure = false, outdated_after = false;
+  for (std::size_t i = 0; i < d.truth.size(); ++i) {
+    slam.processScan(d.odom[i], scanAt(w, d.truth[i], rng), 0.1 * i);
+    if (slam.stats().optimizations == 0) {
+      outdated_before_closure = outdated_before_closure || slam.mapOutdated();
+      if (i % 50 == 0) slam.occupancy(0.25);  // drawn now and then, as the node does
+    } else if (slam.mapOutdated()) {
+      outdated_after = true;
+      slam.occupancy(0.25);
+      EXPECT_FALSE(slam.mapOutdated()) << "drawing the map brings it up to date";
+    }
+  }
+  EXPECT_FALSE(outdated_before_closure) << "new nodes alone are drawn incrementally";
+  EXPECT_TRUE(outdated_after) << "the second lap's closures move the first lap's nodes";
+  ASSERT_GE(slam.stats().optimizations, 1);
+}
+
 // A robot left running goes round the same rooms for hours: after the first laps, the nodes repeat
 // places the map has, so their scans are freed and no new submaps are kept; the map and the pose
 // stay as good, and closures that agree with the graph do not make it solve again.
@@ -262,6 +286,14 @@ TEST(GraphSlam, RejectsBadParametersByName) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("local_search_max_window"), std::string::npos);
+  }
+  p = GraphSlamParams();
+  p.local_match_sigma = std::nan("");
+  try {
+    GraphSlam slam(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("local_match_sigma"), std::string::npos);
   }
 }
 

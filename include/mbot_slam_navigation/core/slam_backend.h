@@ -37,6 +37,10 @@ class SlamBackend {
   virtual std::vector<TrajectoryNode> trajectory() const = 0;
   /// gmapping's occupancy picture of the map (hits / visits > occ_thresh is occupied).
   virtual OccupancyImage occupancy(double occ_thresh) const = 0;
+  /// True when the estimate has moved what occupancy() last drew without a new update (the pose
+  /// graph's optimizer, in its own thread, after a loop closure): the map is worth publishing again
+  /// even if the robot stands still.
+  virtual bool mapOutdated() const { return false; }
   virtual int updates() const = 0;
 };
 
