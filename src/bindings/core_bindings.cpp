@@ -452,6 +452,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("loop_min_response", &GraphSlamParams::loop_min_response)
       .def_readwrite("loop_ambiguity", &GraphSlamParams::loop_ambiguity)
       .def_readwrite("loop_sigma_distance", &GraphSlamParams::loop_sigma_distance)
+      .def_readwrite("loop_visible_shift", &GraphSlamParams::loop_visible_shift)
       .def_readwrite("loop_candidates", &GraphSlamParams::loop_candidates)
       .def_readwrite("loop_reject_chi2", &GraphSlamParams::loop_reject_chi2)
       .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)
@@ -492,6 +493,7 @@ PYBIND11_MODULE(_core, m) {
              d["closures_accepted"] = st.closures_accepted;
              d["merged_nodes"] = st.merged_nodes;
              d["closures_moved"] = st.closures_moved;
+             d["closures_remeasured"] = st.closures_remeasured;
              d["closures_unsolved"] = st.closures_unsolved;
              d["closure_backlog"] = st.closure_backlog;
              d["closure_backlog_max"] = st.closure_backlog_max;

@@ -217,9 +217,11 @@ void Visibility::add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, c
   if (v.increment != 0.0 && !v.reach.empty()) views_.push_back(std::move(v));
 }
 
-bool Visibility::seen(const Eigen::Vector2d& p, double tolerance_m) const {
+bool Visibility::seen(const Eigen::Vector2d& p, double tolerance_m, const Eigen::Vector2d* normal) const {
   for (const View& v : views_) {
     const Eigen::Vector2d d = p - v.origin;
+    // A scan behind the surface (the other face of a wall) did not see this side of it.
+    if (normal && d.dot(*normal) >= 0.0) continue;
     const double rho = d.norm();
     const int n = static_cast<int>(v.reach.size());
     // bearing relative to beam 0, in [0, 2 pi) along the direction the beams advance
@@ -239,12 +241,40 @@ bool Visibility::seen(const Eigen::Vector2d& p, double tolerance_m) const {
 }
 
 std::vector<Eigen::Vector2d> Visibility::seenOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
-                                               double tolerance_m) const {
+                                               double tolerance_m, const std::vector<Eigen::Vector2d>* normals) const {
   std::vector<Eigen::Vector2d> out;
   out.reserve(points.size());
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
-  for (const auto& p : points) {
-    if (seen({pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y()}, tolerance_m)) out.push_back(p);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d& p = points[i];
+    const Eigen::Vector2d w(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
+    bool ok;
+    if (normals && !(*normals)[i].isZero()) {
+      const Eigen::Vector2d& n = (*normals)[i];
+      const Eigen::Vector2d nw(c * n.x() - s * n.y(), s * n.x() + c * n.y());
+      ok = seen(w, tolerance_m, &nw);
+    } else {
+      ok = seen(w, tolerance_m);
+    }
+    if (ok) out.push_back(p);
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector2d> surfaceNormals(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& origin,
+                                            double max_gap_m) {
+  std::vector<Eigen::Vector2d> out(points.size(), Eigen::Vector2d::Zero());
+  for (std::size_t i = 1; i + 1 < points.size(); ++i) {
+    const Eigen::Vector2d& a = points[i - 1];
+    const Eigen::Vector2d& b = points[i + 1];
+    // Both neighbours on the same surface, or the point is an edge and its side is not known.
+    if ((a - points[i]).norm() > max_gap_m || (b - points[i]).norm() > max_gap_m) continue;
+    const Eigen::Vector2d t = b - a;
+    if (t.norm() < 1e-9) continue;
+    Eigen::Vector2d n(-t.y(), t.x());
+    n.normalize();
+    if (n.dot(origin - points[i]) < 0.0) n = -n;  // towards the laser that saw it
+    out[i] = n;
   }
   return out;
 }

@@ -166,6 +166,48 @@ TEST(CorrelativeMatcher, TheInterpolatedScorePeaksOnAWallThatLiesOnACellBorder) 
   EXPECT_NEAR(grid.interpolated({1.0, 0.985}), grid.interpolated({1.0, 1.015}), 1e-3);
 }
 
+TEST(CorrelativeMatcher, SurfaceNormalsFaceTheLaserAndAreUnknownAtEdges) {
+  // A wall along y = 1 seen from the origin, then one point 1 m off it (a depth edge).
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = -0.5; x <= 0.51; x += 0.05) pts.emplace_back(x, 1.0);
+  pts.emplace_back(1.5, 2.0);
+  const auto n = surfaceNormals(pts, {0.0, 0.0}, 0.3);
+  ASSERT_EQ(n.size(), pts.size());
+  EXPECT_TRUE(n.front().isZero()) << "an end has one neighbour";
+  for (std::size_t i = 1; i + 2 < pts.size(); ++i) {
+    EXPECT_NEAR(n[i].x(), 0.0, 1e-9) << i;
+    EXPECT_NEAR(n[i].y(), -1.0, 1e-9) << i << ": towards the laser";
+  }
+  EXPECT_TRUE(n[pts.size() - 2].isZero()) << "its next neighbour lies 1.1 m off: an edge";
+  EXPECT_TRUE(n.back().isZero());
+  // Seen from the other side, the same wall faces the other way.
+  EXPECT_NEAR(surfaceNormals(pts, {0.0, 3.0}, 0.3)[5].y(), 1.0, 1e-9);
+}
+
+TEST(CorrelativeMatcher, VisibilityTellsAWallsFaceFromTheFaceBehindIt) {
+  // A wall 0.1 m thick across x = 3.0 .. 3.1, seen by one scan from the origin (its west face).
+  // A scan from beyond it, at (6, 0), sees the east face 0.1 m behind: within a tolerance that a
+  // pose a few centimetres off needs, but not a face that scan saw.
+  World2D w;
+  w.addBox({3.05, 0}, 0, 0.1, 2.0);
+  std::mt19937 rng(3);
+  const Eigen::Vector3d pose(0.0, 0.0, 0.0), laser(0.0, 0.0, 0.0);
+  const LaserScan s = scanAt(w, pose, rng, 0.0);
+  Visibility v;
+  v.add(s, laser, pose, 5.0);
+  const Eigen::Vector2d west(-1.0, 0.0), east(1.0, 0.0);  // each face's normal, towards its viewer
+  EXPECT_TRUE(v.seen({3.0, 0.5}, 0.15, &west)) << "the face it saw";
+  EXPECT_TRUE(v.seen({3.1, 0.5}, 0.15)) << "the other face, within the tolerance";
+  EXPECT_FALSE(v.seen({3.1, 0.5}, 0.15, &east)) << "the other face, seen from beyond the wall";
+  EXPECT_TRUE(v.seen({2.0, 0.3}, 0.15, &west)) << "in the open, a surface facing the scan";
+  EXPECT_FALSE(v.seen({2.0, 0.3}, 0.15, &east)) << "in the open, a surface facing away from it";
+  // The same through seenOf, in the frame of a base at (6, 0) facing -x.
+  const std::vector<Eigen::Vector2d> points{{2.9, -0.5}, {2.9, -0.55}, {2.9, -0.6}};
+  const auto normals = surfaceNormals(points, {0.0, 0.0}, 0.3);
+  EXPECT_EQ(v.seenOf(points, {6.0, 0.0, M_PI}, 0.15).size(), 3u);
+  EXPECT_EQ(v.seenOf(points, {6.0, 0.0, M_PI}, 0.15, &normals).size(), 2u) << "the middle one has a side; the ends do not";
+}
+
 TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
   // The base at the origin facing +y, its laser turned to face +x; a wall 2 m long across x = 3.
   World2D w;

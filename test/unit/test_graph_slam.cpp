@@ -295,6 +295,14 @@ TEST(GraphSlam, RejectsBadParametersByName) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("local_match_sigma"), std::string::npos);
   }
+  p = GraphSlamParams();
+  p.loop_visible_shift = -0.1;
+  try {
+    GraphSlam slam(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("loop_visible_shift"), std::string::npos);
+  }
 }
 
 namespace {

@@ -91,6 +91,12 @@ std::vector<Eigen::Vector2d> matchPoints(const LaserScan& scan, const Eigen::Vec
 std::vector<Eigen::Vector2d> surfacePoints(const LaserScan& scan, const Eigen::Vector3d& laser_pose, double max_range_m,
                                            double voxel_m);
 
+/// Unit normals of a scan's `points` (in beam order, as matchPoints gives them), each facing
+/// `origin` (the laser, same frame), from the neighbours either side; zero where a neighbour lies
+/// farther than `max_gap_m` (an edge: the surface's side is not known) and at both ends.
+std::vector<Eigen::Vector2d> surfaceNormals(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& origin,
+                                            double max_gap_m);
+
 /// What a set of scans could see, for leaving out of a match the returns that the reference scans
 /// could not have seen: a point counts as seen when some scan's beam nearest its bearing reached
 /// at least that far, within a tolerance; a beam without a return reached its maximum range. A
@@ -107,11 +113,16 @@ class Visibility {
   /// Adds what `scan` saw from `pose` (the base in the reference frame), its beams from
   /// `laser_pose` in the base frame, reaching at most `max_range_m`.
   void add(const LaserScan& scan, const Eigen::Vector3d& laser_pose, const Eigen::Vector3d& pose, double max_range_m);
-  /// Whether some added scan saw `p` (reference frame), with `tolerance_m` beyond its returns.
-  bool seen(const Eigen::Vector2d& p, double tolerance_m) const;
-  /// The `points` (base frame) that some added scan saw when the base is at `pose`.
+  /// Whether some added scan saw `p` (reference frame), with `tolerance_m` beyond its returns;
+  /// with `normal` (reference frame, unit, the side of the surface at `p` that counts), only a scan
+  /// from that side counts: a wall's other face lies a wall's thickness behind this one, within
+  /// the tolerance of a pose a few centimetres off.
+  bool seen(const Eigen::Vector2d& p, double tolerance_m, const Eigen::Vector2d* normal = nullptr) const;
+  /// The `points` (base frame) that some added scan saw when the base is at `pose`; with `normals`
+  /// (base frame, one per point as surfaceNormals gives them), only from the side of the surface
+  /// they face.
   std::vector<Eigen::Vector2d> seenOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
-                                      double tolerance_m) const;
+                                      double tolerance_m, const std::vector<Eigen::Vector2d>* normals = nullptr) const;
   bool empty() const { return views_.empty(); }
   void clear() { views_.clear(); }
 

@@ -139,6 +139,13 @@ struct GraphSlamParams {
   /// closures from 1-2 m off were 2.5 cm short on average, from within 0.5 m 0.04 cm; at equal
   /// weight they shrank its map by 0.6%). 0: every closure weighs as a chain edge.
   double loop_sigma_distance = 0.25;
+  /// [m] A closure is measured again with only the returns its submap saw, from the side of the
+  /// surface they face (`~loop_visible_shift`): the other face of a wall, seen from beyond it, pulls
+  /// the match towards the submap by up to the wall's thickness. Over a recorded large-floor run's
+  /// closures the radial error from 1-3 m off the submap went from -3 to -8 cm on average to -0.2
+  /// to -0.9 cm. The second measurement is kept when it lies within this distance (and 0.05 rad) of
+  /// the first and at least a quarter of the returns were seen. 0: measured once, with all returns.
+  double loop_visible_shift = 0.15;
   double loop_reject_chi2 = 50.0;   ///< closures above this error after optimizing are removed
   double edge_sigma_xy = 0.03;      ///< [m] standard deviation of an edge's translation
   double edge_sigma_theta = 0.01;   ///< [rad] and of its rotation
@@ -174,6 +181,7 @@ struct GraphSlamStats {
   int loop_closures = 0;            ///< closure edges in the graph
   int closures_accepted = 0;        ///< closures ever accepted (some since merged into others)
   int closures_moved = 0;           ///< closures moved from a merged node to the node before it
+  int closures_remeasured = 0;      ///< closures accepted as measured again with what their submap saw (loop_visible_shift)
   int merged_nodes = 0;             ///< trimmed nodes taken out of the optimization
   int loop_rejected_ambiguous = 0;
   int loop_rejected_inconsistent = 0;  ///< removed after optimization
@@ -284,6 +292,8 @@ class GraphSlam : public SlamBackend {
   // Submap grids whose pooled levels are kept, most recently matched first (closure thread only),
   // and the bytes they may hold (grids and levels; the most recent is kept whatever its size).
   static constexpr std::size_t kPyramidBytes = 4u << 20;
+  // [rad] the most the second climb of a closure (loop_visible_shift) may turn it
+  static constexpr double kMaxVisibleTurn = 0.05;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
   GraphSlamStats stats_;  // counters; nodes and loop_closures are derived in stats()
