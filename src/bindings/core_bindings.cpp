@@ -453,6 +453,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("loop_ambiguity", &GraphSlamParams::loop_ambiguity)
       .def_readwrite("loop_sigma_distance", &GraphSlamParams::loop_sigma_distance)
       .def_readwrite("loop_visible_shift", &GraphSlamParams::loop_visible_shift)
+      .def_readwrite("local_visible_side", &GraphSlamParams::local_visible_side)
       .def_readwrite("loop_candidates", &GraphSlamParams::loop_candidates)
       .def_readwrite("loop_reject_chi2", &GraphSlamParams::loop_reject_chi2)
       .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)

@@ -57,6 +57,7 @@ void GraphSlamParams::validate() const {
   if (!(loop_search_angle >= 0.0)) throw std::invalid_argument("loop_search_angle must be >= 0");
   if (!(loop_min_response > 0.0 && loop_min_response <= 1.0)) throw std::invalid_argument("loop_min_response must lie in (0, 1]");
   if (!(loop_ambiguity > 0.0 && loop_ambiguity <= 1.0)) throw std::invalid_argument("loop_ambiguity must lie in (0, 1]");
+  if (local_visible_side && !local_visible_only) throw std::invalid_argument("local_visible_side needs local_visible_only");
   if (!(loop_sigma_distance >= 0.0)) throw std::invalid_argument("loop_sigma_distance must be >= 0");
   if (!(loop_visible_shift >= 0.0)) throw std::invalid_argument("loop_visible_shift must be >= 0 (0: off)");
   at_least(loop_candidates, 0, "loop_candidates");
@@ -139,7 +140,12 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       // Only what the local map's scans could have seen (Visibility): the rest came into view as
       // the robot drove on and pulls the match back. Judged at the prediction, a cell of slack;
       // when most of the scan is new (a door just passed), all of it, rather than a few returns.
-      std::vector<Eigen::Vector2d> seen = local_seen_.seenOf(near, predicted, params_.delta);
+      // With local_visible_side, seen from the side each return faces: a wall's other face, seen
+      // through the door just passed, lies within that slack of the face the map holds.
+      std::vector<Eigen::Vector2d> normals;
+      if (params_.local_visible_side) normals = surfaceNormals(near, laser, 0.3);
+      std::vector<Eigen::Vector2d> seen =
+          local_seen_.seenOf(near, predicted, params_.delta, params_.local_visible_side ? &normals : nullptr);
       if (2 * seen.size() >= near.size()) near.swap(seen);
     }
     tracked = matchLocally(predicted, near);

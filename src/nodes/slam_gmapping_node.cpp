@@ -148,6 +148,7 @@ class SlamGmappingNode {
     param("local_prior_weight", g.local_prior_weight);
     param("local_prior_points", g.local_prior_points);
     param("local_visible_only", g.local_visible_only);
+    param("local_visible_side", g.local_visible_side);
     param("submap_nodes", g.submap_nodes);
     param("loop_search_radius", g.loop_search_radius);
     param("loop_search_growth", g.loop_search_growth);

@@ -271,38 +271,31 @@ TEST(GraphSlam, RejectsBadParametersByName) {
   GraphSlamParams p;
   p.loop_min_response = 1.5;
   EXPECT_THROW(GraphSlam{p}, std::invalid_argument);
+  // Each bad value is refused with a message that names the parameter.
+  const auto expect_named = [](const GraphSlamParams& bad, const std::string& name) {
+    try {
+      GraphSlam slam(bad);
+      ADD_FAILURE() << name << ": accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  };
   p = GraphSlamParams();
   p.submap_nodes = 0;
-  try {
-    GraphSlam slam(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("submap_nodes"), std::string::npos);
-  }
+  expect_named(p, "submap_nodes");
   p = GraphSlamParams();
   p.local_search_max_window = 0.1;  // below local_search_window
-  try {
-    GraphSlam slam(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("local_search_max_window"), std::string::npos);
-  }
+  expect_named(p, "local_search_max_window");
   p = GraphSlamParams();
   p.local_match_sigma = std::nan("");
-  try {
-    GraphSlam slam(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("local_match_sigma"), std::string::npos);
-  }
+  expect_named(p, "local_match_sigma");
   p = GraphSlamParams();
   p.loop_visible_shift = -0.1;
-  try {
-    GraphSlam slam(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("loop_visible_shift"), std::string::npos);
-  }
+  expect_named(p, "loop_visible_shift");
+  p = GraphSlamParams();
+  p.local_visible_only = false;
+  p.local_visible_side = true;  // a side of what was seen, without what was seen
+  expect_named(p, "local_visible_side");
 }
 
 namespace {
