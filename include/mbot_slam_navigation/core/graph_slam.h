@@ -130,7 +130,7 @@ struct GraphSlamParams {
   /// face of the wall beside it, a wall's thickness behind the face the local map holds, and a
   /// scan 6.6 cm off matched it 3% better than the right pose (one node step 8-9 cm off, three times
   /// at one door of a recorded large-floor run). On the 14 recorded large-floor runs (2 draws) the
-  /// maps' walls came out at 99.3-99.5% on average (98.4-98.7% without), the worst 94.7-95.9%
+  /// maps' walls came out at 99.5% on average (98.4-98.7% without), the worst 95.6-95.8%
   /// (86.1-88.9%); FR079 unchanged, but ACES's online pose 0.071-0.089 m (0.053-0.070 m) over 4
   /// draws, so it is off by default and `explore.launch` (the simulated worlds) turns it on.
   bool local_visible_side = false;
