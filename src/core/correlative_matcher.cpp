@@ -248,15 +248,10 @@ std::vector<Eigen::Vector2d> Visibility::seenOf(const std::vector<Eigen::Vector2
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector2d& p = points[i];
     const Eigen::Vector2d w(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
-    bool ok;
-    if (normals && !(*normals)[i].isZero()) {
-      const Eigen::Vector2d& n = (*normals)[i];
-      const Eigen::Vector2d nw(c * n.x() - s * n.y(), s * n.x() + c * n.y());
-      ok = seen(w, tolerance_m, &nw);
-    } else {
-      ok = seen(w, tolerance_m);
-    }
-    if (ok) out.push_back(p);
+    Eigen::Vector2d side;  // the normal in the reference frame, where the point has one
+    const bool has_side = normals && !(*normals)[i].isZero();
+    if (has_side) side << c * (*normals)[i].x() - s * (*normals)[i].y(), s * (*normals)[i].x() + c * (*normals)[i].y();
+    if (seen(w, tolerance_m, has_side ? &side : nullptr)) out.push_back(p);
   }
   return out;
 }

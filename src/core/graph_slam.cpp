@@ -143,7 +143,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       // With local_visible_side, seen from the side each return faces: a wall's other face, seen
       // through the door just passed, lies within that slack of the face the map holds.
       std::vector<Eigen::Vector2d> normals;
-      if (params_.local_visible_side) normals = surfaceNormals(near, laser, 0.3);
+      if (params_.local_visible_side) normals = surfaceNormals(near, laser, kSurfaceGap);
       std::vector<Eigen::Vector2d> seen =
           local_seen_.seenOf(near, predicted, params_.delta, params_.local_visible_side ? &normals : nullptr);
       if (2 * seen.size() >= near.size()) near.swap(seen);
@@ -495,6 +495,7 @@ bool GraphSlam::searchClosures(int n) {
   if (static_cast<int>(candidates.size()) > wanted) candidates.resize(wanted);
 
   bool added = false;
+  std::vector<Eigen::Vector2d> normals;  // of n's points (loop_visible_shift)
   for (const Candidate& c : candidates) {
     const Eigen::Vector3d init = relativePose(c.anchor, pose);
     const MatchWindow window{radius, params_.loop_search_angle};
@@ -543,7 +544,8 @@ bool GraphSlam::searchClosures(int n) {
       // only the returns the submap saw from the side they face, judged at the pose the climb
       // reached, twice; the first climb's pose is kept when fewer than a quarter of the returns
       // are left or the second moves it farther than loop_visible_shift (a wrong local optimum).
-      const std::vector<Eigen::Vector2d> normals = surfaceNormals(*points, params_.matcher.laser_pose.head<2>(), 0.3);
+      // The scan's normals serve every candidate submap: worked out for the first that needs them.
+      if (normals.empty()) normals = surfaceNormals(*points, params_.matcher.laser_pose.head<2>(), kSurfaceGap);
       Eigen::Vector3d v = refined;
       bool ok = true;
       for (int pass = 0; pass < 2 && ok; ++pass) {

@@ -303,6 +303,8 @@ class GraphSlam : public SlamBackend {
   static constexpr std::size_t kPyramidBytes = 4u << 20;
   // [rad] the most the second climb of a closure (loop_visible_shift) may turn it
   static constexpr double kMaxVisibleTurn = 0.05;
+  // [m] neighbouring returns farther apart lie on different surfaces: no normal (surfaceNormals)
+  static constexpr double kSurfaceGap = 0.3;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
   GraphSlamStats stats_;  // counters; nodes and loop_closures are derived in stats()
