@@ -448,6 +448,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("loop_search_radius", &GraphSlamParams::loop_search_radius)
       .def_readwrite("loop_search_growth", &GraphSlamParams::loop_search_growth)
       .def_readwrite("loop_search_max_radius", &GraphSlamParams::loop_search_max_radius)
+      .def_readwrite("loop_search_reach", &GraphSlamParams::loop_search_reach)
       .def_readwrite("loop_search_angle", &GraphSlamParams::loop_search_angle)
       .def_readwrite("loop_min_response", &GraphSlamParams::loop_min_response)
       .def_readwrite("loop_ambiguity", &GraphSlamParams::loop_ambiguity)

@@ -54,6 +54,7 @@ void GraphSlamParams::validate() const {
   positive(loop_search_radius, "loop_search_radius");
   if (!(loop_search_growth >= 0.0)) throw std::invalid_argument("loop_search_growth must be >= 0");
   if (!(loop_search_max_radius >= loop_search_radius)) throw std::invalid_argument("loop_search_max_radius must be >= loop_search_radius");
+  if (!(loop_search_reach >= 0.0)) throw std::invalid_argument("loop_search_reach must be >= 0");
   if (!(loop_search_angle >= 0.0)) throw std::invalid_argument("loop_search_angle must be >= 0");
   if (!(loop_min_response > 0.0 && loop_min_response <= 1.0)) throw std::invalid_argument("loop_min_response must lie in (0, 1]");
   if (!(loop_ambiguity > 0.0 && loop_ambiguity <= 1.0)) throw std::invalid_argument("loop_ambiguity must lie in (0, 1]");
@@ -485,7 +486,7 @@ bool GraphSlam::searchClosures(int n) {
       if (s.last >= recent) continue;
       double nearest = std::numeric_limits<double>::infinity();
       for (int k = s.first; k <= s.last; ++k) nearest = std::min(nearest, (nodes_[k].pose.head<2>() - pose.head<2>()).norm());
-      if (nearest <= radius) candidates.push_back({nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen});
+      if (nearest <= radius + params_.loop_search_reach) candidates.push_back({nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen});
     }
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });

@@ -153,6 +153,7 @@ class SlamGmappingNode {
     param("loop_search_radius", g.loop_search_radius);
     param("loop_search_growth", g.loop_search_growth);
     param("loop_search_max_radius", g.loop_search_max_radius);
+    param("loop_search_reach", g.loop_search_reach);
     param("loop_search_angle", g.loop_search_angle);
     param("loop_min_response", g.loop_min_response);
     param("loop_ambiguity", g.loop_ambiguity);

@@ -293,6 +293,9 @@ TEST(GraphSlam, RejectsBadParametersByName) {
   p.loop_visible_shift = -0.1;
   expect_named(p, "loop_visible_shift");
   p = GraphSlamParams();
+  p.loop_search_reach = -1.0;
+  expect_named(p, "loop_search_reach");
+  p = GraphSlamParams();
   p.local_visible_only = false;
   p.local_visible_side = true;  // a side of what was seen, without what was seen
   expect_named(p, "local_visible_side");
@@ -634,4 +637,55 @@ TEST(GraphSlam, ClosuresFromAnotherLaneDoNotPullTheMapTogether) {
   EXPECT_LT(weighed.worst, 0.04) << "closures from the other lane should not pull the map out of shape";
   EXPECT_GT(equal.worst, 0.05) << "at equal weight they do (else this test shows nothing)";
   EXPECT_LT(weighed.mean, equal.mean);
+}
+
+TEST(GraphSlam, SubmapsAreTriedFromWithinReachWhileTheWindowStaysTheDrift) {
+  // Exploring a large floor the robot seldom passes within the search radius (the window, sized to
+  // the drift) of where it was, but often within a few metres, where its scan shares much of what
+  // the submap's nodes saw. Here the corridor of rooms is driven east in one lane and back west in
+  // the other, 1 m away, with exact odometry and a window of 0.3 m: the way back finds the way out's
+  // submaps only through loop_search_reach, and the closures it makes are right.
+  const World2D w = officeCorridor();
+  std::vector<Eigen::Vector3d> truth;
+  Eigen::Vector3d pose(1.0, 0.5, 0.0);
+  auto step = [&](double ds, double dth) {
+    pose = integrateArc(pose, ds, dth);
+    truth.push_back(pose);
+  };
+  truth.push_back(pose);
+  for (int k = 0; k < 500; ++k) step(0.037, 0.0);                          // east, 18.5 m
+  for (int k = 0; k < 20; ++k) step(M_PI * 0.5 / 20.0, -M_PI / 20.0);       // a U-turn (radius 0.5 m)
+  for (int k = 0; k < 500; ++k) step(0.037, 0.0);                          // west
+  struct Result {
+    int attempts = 0, closures = 0;
+    double worst = 0.0;  // [m] of the optimized trajectory against the truth
+  };
+  auto run = [&](double reach) {
+    GraphSlamParams p;
+    p.matcher.max_range = 6.0;
+    p.matcher.max_urange = 6.0;
+    p.linear_update = 0.3;  // nodes close enough for the way back to find submaps of the way out
+    p.background = false;
+    p.loop_search_radius = 0.3;
+    p.loop_search_growth = 0.0;
+    p.loop_search_reach = reach;
+    GraphSlam slam(p);
+    std::mt19937 rng(11);
+    for (std::size_t i = 0; i < truth.size(); ++i) slam.processScan(truth[i], mbotScanAt(w, truth[i], rng), 0.1 * i);
+    slam.flush();
+    Result r;
+    r.attempts = slam.stats().loop_attempts;
+    r.closures = slam.stats().loop_closures;
+    const auto poses = slam.scanPoses();
+    for (std::size_t i = 0; i < poses.size(); ++i) r.worst = std::max(r.worst, (poses[i].second.head<2>() - truth[i].head<2>()).norm());
+    return r;
+  };
+  const Result within = run(0.0), reached = run(GraphSlamParams().loop_search_reach);
+  std::printf("reach 0: %d submaps tried, %d closures; reach %.1f m: %d tried, %d closures, worst error %.4f m\n",
+              within.attempts, within.closures, GraphSlamParams().loop_search_reach, reached.attempts,
+              reached.closures, reached.worst);
+  EXPECT_EQ(within.closures, 0) << "no node of the way back is within 0.3 m of the way out";
+  EXPECT_GE(reached.closures, 5) << "the way back should close on the way out from the other lane";
+  // Measured: 0.041 m. A closure to the room next door would put the way back 4 m off.
+  EXPECT_LT(reached.worst, 0.1) << "and its closures should be right";
 }
