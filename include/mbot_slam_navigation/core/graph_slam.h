@@ -141,10 +141,11 @@ struct GraphSlamParams {
   /// travelled since (`~loop_search_growth`) to loop_search_max_radius (`~loop_search_max_radius`).
   /// A window wider than the drift finds the place next door: in the large floor's row of like rooms
   /// a node was put 3 m off (2 m and 0.05 m per m, the old defaults: 2 of 17 recorded runs' maps
-  /// broke as soon as more submaps were tried). The simulator's and the Radish logs' corrections
-  /// stay well within 1 m and 0.02 m per m.
+  /// broke as soon as more submaps were tried; with 0.02 m per m a live run's map broke after 3 m
+  /// of window had grown). The simulator's and the Radish logs' corrections stay well within 1 m
+  /// and 0.01 m per m.
   double loop_search_radius = 1.0;
-  double loop_search_growth = 0.02;
+  double loop_search_growth = 0.01;
   double loop_search_max_radius = 6.0;
   /// [m] Submaps with a node within the search radius plus this are tried (`~loop_search_reach`):
   /// a scan shares much of what a submap's nodes saw from a few metres off them (the laser reaches
