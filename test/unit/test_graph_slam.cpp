@@ -488,6 +488,16 @@ std::vector<Eigen::Vector3d> outAndBack(double lane_gap) {
   for (int k = 0; k < 500; ++k) step(0.037, 0.0);
   return truth;
 }
+
+/// For outAndBack() with the mbot's 6 m laser, inline (deterministic).
+GraphSlamParams laneParams() {
+  GraphSlamParams p;
+  p.matcher.max_range = 6.0;
+  p.matcher.max_urange = 6.0;
+  p.linear_update = 0.3;  // nodes close enough for the way back to find submaps of the way out
+  p.background = false;
+  return p;
+}
 }  // namespace
 
 TEST(GraphSlam, TrackingAlongACorridorOfRoomsDoesNotShortenIt) {
@@ -611,11 +621,7 @@ TEST(GraphSlam, ClosuresFromAnotherLaneDoNotPullTheMapTogether) {
     int closures = 0;
   };
   auto run = [&](double sigma_distance) {
-    GraphSlamParams p;
-    p.matcher.max_range = 6.0;
-    p.matcher.max_urange = 6.0;
-    p.linear_update = 0.3;  // nodes close enough for the way back to find submaps of the way out
-    p.background = false;
+    GraphSlamParams p = laneParams();
     p.loop_sigma_distance = sigma_distance;
     GraphSlam slam(p);
     std::mt19937 rng(9);
@@ -659,11 +665,7 @@ TEST(GraphSlam, SubmapsAreTriedFromWithinReachWhileTheWindowStaysTheDrift) {
     double worst = 0.0;  // [m] of the optimized trajectory against the truth
   };
   auto run = [&](double reach) {
-    GraphSlamParams p;
-    p.matcher.max_range = 6.0;
-    p.matcher.max_urange = 6.0;
-    p.linear_update = 0.3;  // nodes close enough for the way back to find submaps of the way out
-    p.background = false;
+    GraphSlamParams p = laneParams();
     p.loop_search_radius = 0.3;
     p.loop_search_growth = 0.0;
     p.loop_search_reach = reach;
