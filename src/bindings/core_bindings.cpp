@@ -456,6 +456,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("loop_visible_shift", &GraphSlamParams::loop_visible_shift)
       .def_readwrite("local_visible_side", &GraphSlamParams::local_visible_side)
       .def_readwrite("loop_candidates", &GraphSlamParams::loop_candidates)
+      .def_readwrite("loop_recent_submap", &GraphSlamParams::loop_recent_submap)
       .def_readwrite("loop_reject_chi2", &GraphSlamParams::loop_reject_chi2)
       .def_readwrite("edge_sigma_xy", &GraphSlamParams::edge_sigma_xy)
       .def_readwrite("edge_sigma_theta", &GraphSlamParams::edge_sigma_theta)
@@ -496,6 +497,7 @@ PYBIND11_MODULE(_core, m) {
              d["merged_nodes"] = st.merged_nodes;
              d["closures_moved"] = st.closures_moved;
              d["closures_remeasured"] = st.closures_remeasured;
+             d["closures_recent"] = st.closures_recent;
              d["closures_unsolved"] = st.closures_unsolved;
              d["closure_backlog"] = st.closure_backlog;
              d["closure_backlog_max"] = st.closure_backlog_max;

@@ -463,8 +463,10 @@ bool GraphSlam::searchClosures(int n) {
     int anchor_index, last;  // the submap's nodes [anchor_index, last]
     std::shared_ptr<const LikelihoodGrid> grid;
     std::shared_ptr<const Visibility> seen;
+    bool recent;
   };
   std::vector<Candidate> candidates;
+  Candidate recent_candidate{0.0, Eigen::Vector3d::Zero(), -1, -1, nullptr, nullptr, false};
   Eigen::Vector3d pose;
   std::shared_ptr<const std::vector<Eigen::Vector2d>> points;
   double travelled, radius;
@@ -480,13 +482,21 @@ bool GraphSlam::searchClosures(int n) {
     radius = std::min(params_.loop_search_max_radius,
                       params_.loop_search_radius + params_.loop_search_growth * (travelled - last_closure_travelled_));
     stats_.search_radius_m = radius;
-    // Submaps the local map may still overlap are not loops.
+    // Submaps the local map may still overlap are not loops. The newest one whose nodes have all
+    // left n's local map (n's tracking saw none of their scans) is loop_recent_submap's.
     const int recent = n - params_.local_map_nodes - params_.submap_nodes;
+    const int behind = params_.loop_recent_submap ? n - params_.local_map_nodes : recent;
     for (const Submap& s : submaps_) {
-      if (s.last >= recent) continue;
+      if (s.last >= behind) continue;
       double nearest = std::numeric_limits<double>::infinity();
       for (int k = s.first; k <= s.last; ++k) nearest = std::min(nearest, (nodes_[k].pose.head<2>() - pose.head<2>()).norm());
-      if (nearest <= radius + params_.loop_search_reach) candidates.push_back({nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen});
+      if (s.last >= recent) {
+        if (nearest <= params_.loop_search_reach && s.first > recent_candidate.anchor_index) {
+          recent_candidate = {nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen, true};
+        }
+        continue;
+      }
+      if (nearest <= radius + params_.loop_search_reach) candidates.push_back({nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen, false});
     }
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
@@ -494,12 +504,16 @@ bool GraphSlam::searchClosures(int n) {
   // more would only grow the graph.
   const int wanted = redundant ? std::min(1, params_.loop_candidates) : params_.loop_candidates;
   if (static_cast<int>(candidates.size()) > wanted) candidates.resize(wanted);
+  // Besides those: it measures the chain, not a loop.
+  if (recent_candidate.anchor_index >= 0) candidates.push_back(recent_candidate);
 
   bool added = false;
   std::vector<Eigen::Vector2d> normals;  // of n's points (loop_visible_shift)
   for (const Candidate& c : candidates) {
     const Eigen::Vector3d init = relativePose(c.anchor, pose);
-    const MatchWindow window{radius, params_.loop_search_angle};
+    // A recent submap is a few tens of nodes back along the chain: its drift is tracking's.
+    const MatchWindow window = c.recent ? MatchWindow{params_.local_search_max_window, params_.local_search_angle}
+                                        : MatchWindow{radius, params_.loop_search_angle};
     const MatchResult found = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_min_response);
     cachePyramid(c.grid);
     int ambiguous = 0;
@@ -586,7 +600,11 @@ bool GraphSlam::searchClosures(int n) {
     edges_.push_back({c.anchor_index, n, refined, edgeInformation(scale), true});
     ++stats_.closures_accepted;
     if (remeasured) ++stats_.closures_remeasured;
-    last_closure_travelled_ = travelled;
+    if (c.recent) {
+      ++stats_.closures_recent;
+    } else {
+      last_closure_travelled_ = travelled;  // the drift since a recent submap says nothing of a loop's
+    }
     const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);
     if (err.dot(edges_.back().information * err) > params_.loop_solve_chi2) {
       added = true;

@@ -160,6 +160,7 @@ class SlamGmappingNode {
     param("loop_sigma_distance", g.loop_sigma_distance);
     param("loop_visible_shift", g.loop_visible_shift);
     param("loop_candidates", g.loop_candidates);
+    param("loop_recent_submap", g.loop_recent_submap);
     param("redundant_distance", g.redundant_distance);
     param("redundant_angle", g.redundant_angle);
     param("keep_trimmed_scans", g.keep_trimmed_scans);
@@ -298,13 +299,13 @@ class SlamGmappingNode {
     const mbot::core::GraphSlamStats s = graph->stats();
     struct mallinfo2 heap = mallinfo2();
     ROS_INFO("slam_gmapping: %d nodes (%d revisits, %d of them with their scan freed, %d out of the optimization), "
-             "%d submaps (%.1f MB), %d loop closures (%d of them measured again with what their submap saw, %d in the graph), %d optimizations (last %.0f ms); "
+             "%d submaps (%.1f MB), %d loop closures (%d of them measured again with what their submap saw, %d to the submap just behind the local map, %d in the graph), %d optimizations (last %.0f ms); "
              "closure search backlog %d nodes (at most %d); "
              "scans move odometry's prediction by %.1f mm (rms), so its prior weighs %.0f and the search window is "
              "+-%.2f m; "
              "heap %.1f MB in use, %.1f MB free",
              s.nodes, s.redundant_nodes, s.trimmed_nodes, s.merged_nodes, s.submaps, s.submap_bytes / 1e6,
-             s.closures_accepted, s.closures_remeasured, s.loop_closures, s.optimizations, s.last_optimization_ms, s.closure_backlog,
+             s.closures_accepted, s.closures_remeasured, s.closures_recent, s.loop_closures, s.optimizations, s.last_optimization_ms, s.closure_backlog,
              s.closure_backlog_max,
              1000.0 * s.innovation_rms, s.prior_weight, s.search_window_m,
              (heap.uordblks + heap.hblkhd) / 1e6, heap.fordblks / 1e6);

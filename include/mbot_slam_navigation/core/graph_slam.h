@@ -18,7 +18,10 @@
 // ambiguous: no other pose at least 0.3 m or 0.1 rad away scores within loop_ambiguity of it
 // (a corridor, a row of doors). It weighs less the farther from the submap's nodes the scan was
 // matched (loop_sigma_distance): such a scan shares with them only what lies on their side, and
-// its match leans that way.
+// its match leans that way. With loop_recent_submap, each node is also matched against the newest
+// submap just behind its local map (within loop_search_reach, in the tracking window): those
+// scans are not in the local map, so the match measures the chain over the last few tens of nodes
+// afresh; such closures do not count as closures for the search radius's drift.
 //
 // Optimization. After new closures the graph is solved (pose_graph.h) unless every new closure
 // agrees with the current estimate (error below loop_solve_chi2; a robot revisiting a well-mapped
@@ -145,8 +148,8 @@ struct GraphSlamParams {
   /// of window had grown). The simulator's and the Radish logs' corrections stay well within 1 m
   /// and 0.01 m per m.
   double loop_search_radius = 1.0;
-  double loop_search_growth = 0.01;
-  double loop_search_max_radius = 6.0;
+  double loop_search_growth = 0.01;       ///< [m per m travelled] (`~loop_search_growth`)
+  double loop_search_max_radius = 6.0;    ///< [m] (`~loop_search_max_radius`)
   /// [m] Submaps with a node within the search radius plus this are tried (`~loop_search_reach`):
   /// a scan shares much of what a submap's nodes saw from a few metres off them (the laser reaches
   /// 6 m or more), and exploring a large floor the robot seldom passes within the radius of where
@@ -157,6 +160,15 @@ struct GraphSlamParams {
   double loop_min_response = 0.55;  ///< mean likelihood a closure must reach (`~loop_min_response`)
   double loop_ambiguity = 0.9;      ///< a second pose scoring this share of the best rejects it (`~loop_ambiguity`)
   int loop_candidates = 3;          ///< nearest submaps tried per node (`~loop_candidates`)
+  /// Also match each node against the newest submap whose nodes have all left its local map, if
+  /// one of them lies within loop_search_reach (`~loop_recent_submap`). The older submaps alone are
+  /// loops (the local map may still overlap the one in between); without this, nothing but the
+  /// chain of tracked edges holds a node to the last 30 nodes, and the chain's heading wanders by
+  /// a few hundredths of a degree per node. Searched in the tracking window
+  /// (local_search_max_window, local_search_angle), not the drift's: the chain since is short.
+  /// On 20 recorded large-floor runs, replayed twice: maps at or above 99% walls 36 of 40 with it,
+  /// 34 of 40 without (the worst 91.9 and 93.2% against 88.6 and 89.3%).
+  bool loop_recent_submap = true;
   /// [m] A closure's standard deviations grow with d, the distance from the matched pose to the
   /// nearest node of the submap, as sqrt(1 + (d / this)^2) (`~loop_sigma_distance`): a scan taken
   /// farther off sees less of what the submap saw, and the match leans towards it (an office run's
@@ -206,6 +218,7 @@ struct GraphSlamStats {
   int closures_accepted = 0;        ///< closures ever accepted (some since merged into others)
   int closures_moved = 0;           ///< closures moved from a merged node to the node before it
   int closures_remeasured = 0;      ///< closures accepted as measured again with what their submap saw (loop_visible_shift)
+  int closures_recent = 0;          ///< closures accepted to the submap just behind the local map (loop_recent_submap)
   int merged_nodes = 0;             ///< trimmed nodes taken out of the optimization
   int loop_rejected_ambiguous = 0;
   int loop_rejected_inconsistent = 0;  ///< removed after optimization

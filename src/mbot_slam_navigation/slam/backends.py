@@ -30,14 +30,14 @@ GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
     'local_search_angle': 0.15, 'local_min_score': 0.25, 'local_prior_margin': 0.03,
     'local_prior_weight': 5.0, 'local_prior_points': 130.0, 'local_visible_only': 1, 'local_visible_side': 0, 'submap_nodes': 10, 'loop_search_radius': 1.0,
     'loop_search_growth': 0.01, 'loop_search_max_radius': 6.0, 'loop_search_reach': 2.0, 'loop_search_angle': 0.35,
-    'loop_min_response': 0.55, 'loop_ambiguity': 0.9, 'loop_sigma_distance': 0.25, 'loop_visible_shift': 0.15, 'loop_candidates': 3, 'redundant_distance': 0.3,
+    'loop_min_response': 0.55, 'loop_ambiguity': 0.9, 'loop_sigma_distance': 0.25, 'loop_visible_shift': 0.15, 'loop_candidates': 3, 'loop_recent_submap': 1, 'redundant_distance': 0.3,
     'redundant_angle': 0.5, 'loop_solve_chi2': 7.8, 'keep_trimmed_scans': 0,
 })
 BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
 INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'local_map_nodes', 'submap_nodes',
               'loop_candidates'}
-BOOL_PARAMS = {'local_visible_only', 'local_visible_side', 'keep_trimmed_scans'}
+BOOL_PARAMS = {'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
 
 
 def defaults_of(backend: str) -> Dict[str, float]:
