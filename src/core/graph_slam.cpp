@@ -500,11 +500,12 @@ bool GraphSlam::searchClosures(int n) {
     }
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
-  // A redundant node repeats a place the map has: one closure to the nearest submap anchors it, and
-  // more would only grow the graph.
+  // A redundant node repeats a place the map has: one loop closure to the nearest submap anchors
+  // it, and more would only grow the graph.
   const int wanted = redundant ? std::min(1, params_.loop_candidates) : params_.loop_candidates;
   if (static_cast<int>(candidates.size()) > wanted) candidates.resize(wanted);
-  // Besides those: it measures the chain, not a loop.
+  // The submap behind comes on top, for redundant nodes too: it measures the chain, not a loop
+  // (where revisits dominate, few such submaps are built: see buildSubmap).
   if (recent_candidate.anchor_index >= 0) candidates.push_back(recent_candidate);
 
   bool added = false;
