@@ -256,6 +256,25 @@ std::vector<Eigen::Vector2d> Visibility::seenOf(const std::vector<Eigen::Vector2
   return out;
 }
 
+std::vector<Eigen::Vector2d> Visibility::notBehindOf(const std::vector<Eigen::Vector2d>& points,
+                                                    const Eigen::Vector3d& pose, double tolerance_m, double behind_m,
+                                                    const std::vector<Eigen::Vector2d>& normals) const {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(points.size());
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d& p = points[i];
+    if (i < normals.size() && !normals[i].isZero()) {
+      const Eigen::Vector2d w(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
+      const Eigen::Vector2d side(c * normals[i].x() - s * normals[i].y(), s * normals[i].x() + c * normals[i].y());
+      const Eigen::Vector2d back = -side;
+      if (!seen(w, tolerance_m, &side) && seen(w, behind_m, &back)) continue;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
 std::vector<Eigen::Vector2d> surfaceNormals(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& origin,
                                             double max_gap_m) {
   std::vector<Eigen::Vector2d> out(points.size(), Eigen::Vector2d::Zero());

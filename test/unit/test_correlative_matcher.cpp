@@ -223,6 +223,40 @@ TEST(CorrelativeMatcher, VisibilityTellsAWallsFaceFromTheFaceBehindIt) {
   EXPECT_EQ(v.seenOf(points, {6.0, 0.0, M_PI}, 0.15, &normals).size(), 2u) << "the middle one has a side; the ends do not";
 }
 
+TEST(CorrelativeMatcher, TheOtherFaceOfAWallTheScansSawIsLeftOutOfAScanFromBeyondIt) {
+  // A wall 0.1 m thick across x = 3.0 .. 3.1, seen by one scan from the origin (its west face). A
+  // scan from (4, 0) facing -x, just through a door, sees the east face 0.1 m behind the face the
+  // scan saw, and a wall at x = 5.5 behind itself that no scan saw.
+  World2D w;
+  w.addBox({3.05, 0}, 0, 0.1, 2.0);
+  w.addBox({5.55, 0}, 0, 0.1, 2.0);
+  std::mt19937 rng(3);
+  Visibility v;
+  v.add(scanAt(w, Eigen::Vector3d::Zero(), rng, 0.0), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 12.0);
+  const Eigen::Vector3d pose(4.0, 0.0, M_PI);
+  const auto points = matchPoints(scanAt(w, pose, rng, 0.0), Eigen::Vector3d::Zero(), 11.0, 0.05);
+  const auto normals = surfaceNormals(points, Eigen::Vector2d::Zero(), 0.3);
+  const auto kept = v.notBehindOf(points, pose, 0.05, 0.25, normals);
+  int east_face = 0, far_wall = 0, east_face_kept = 0, far_wall_kept = 0;
+  auto onEastFace = [&](const Eigen::Vector2d& p) { return std::abs(composePose(pose, {p.x(), p.y(), 0}).x() - 3.1) < 0.02; };
+  auto onFarWall = [&](const Eigen::Vector2d& p) { return std::abs(composePose(pose, {p.x(), p.y(), 0}).x() - 5.5) < 0.02; };
+  for (const auto& p : points) {
+    east_face += onEastFace(p);
+    far_wall += onFarWall(p);
+  }
+  for (const auto& p : kept) {
+    east_face_kept += onEastFace(p);
+    far_wall_kept += onFarWall(p);
+  }
+  ASSERT_GT(east_face, 20);
+  ASSERT_GT(far_wall, 20);
+  // Only the ends of the face, which have no normal, stay.
+  EXPECT_LE(east_face_kept, 2) << "of " << east_face << " on the wall's other face";
+  EXPECT_EQ(far_wall_kept, far_wall) << "what no scan saw is new, not behind anything";
+  // Without normals nothing is left out.
+  EXPECT_EQ(v.notBehindOf(points, pose, 0.05, 0.25, {}).size(), points.size());
+}
+
 TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
   // The base at the origin facing +y, its laser turned to face +x; a wall 2 m long across x = 3.
   World2D w;

@@ -128,6 +128,14 @@ class Visibility {
   /// they face.
   std::vector<Eigen::Vector2d> seenOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
                                       double tolerance_m, const std::vector<Eigen::Vector2d>* normals = nullptr) const;
+  /// The `points` (base frame, `normals` as for seenOf) less those on the back of a surface that
+  /// only scans from its other side saw: a point whose own side no added scan saw, while one from
+  /// the other side reached to within `behind_m` of it (a wall's thickness and a pose's slack), is
+  /// the other face of a wall the scans hold, and matched to it would put the scan a wall's
+  /// thickness off. Points without a normal, and points nobody saw, are kept.
+  std::vector<Eigen::Vector2d> notBehindOf(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose,
+                                           double tolerance_m, double behind_m,
+                                           const std::vector<Eigen::Vector2d>& normals) const;
   bool empty() const { return views_.empty(); }
   void clear() { views_.clear(); }
 

@@ -335,6 +335,9 @@ class GraphSlam : public SlamBackend {
   static constexpr double kMaxVisibleTurn = 0.05;
   // [m] neighbouring returns farther apart lie on different surfaces: no normal (surfaceNormals)
   static constexpr double kSurfaceGap = 0.3;
+  // [m] how far behind a face the scans saw its wall's other face may lie (Visibility::notBehindOf):
+  // the generated worlds' 0.1 m walls, seen at up to 60 degrees off square, and a pose's slack
+  static constexpr double kWallBehind = 0.25;
   std::list<std::shared_ptr<const LikelihoodGrid>> pyramids_;
   bool busy_ = false, stop_ = false;
   GraphSlamStats stats_;  // counters; nodes and loop_closures are derived in stats()
