@@ -45,8 +45,8 @@ LikelihoodGrid::LikelihoodGrid(const std::vector<Eigen::Vector2d>& points, doubl
         const int x = c.x + dx;
         if (x < 0 || x >= width_) continue;
         const Eigen::Vector2d d = cellCenter(origin_, resolution_, {x, y}) - p;
-        const auto v = static_cast<LikelihoodGrid::Value>(std::lround(LikelihoodGrid::kMax * std::exp(-d.squaredNorm() * inv_two_sigma2)));
-        LikelihoodGrid::Value& cell = cells_[static_cast<std::size_t>(y) * width_ + x];
+        const auto v = static_cast<Value>(std::lround(kMax * std::exp(-d.squaredNorm() * inv_two_sigma2)));
+        Value& cell = cells_[static_cast<std::size_t>(y) * width_ + x];
         cell = std::max(cell, v);
       }
     }
