@@ -152,7 +152,10 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       } else if (params_.local_visible_side) {
         // Most of the scan is new: a door just passed into a room. The room's side of the wall
         // beside the door lies a wall's thickness behind the face the local map saw from the
-        // corridor; matched to it, a recorded large-floor run's pose jumped 0.1 m, for good.
+        // corridor and pulls the match across the wall: those returns are left out, the rest
+        // (what no scan saw) kept. Replays of 20 large-floor runs: worst map 99.1% walls, 97.8%
+        // without. (Once the local map holds a node from inside the room this no longer applies:
+        // one recorded run still moved 0.1 m across a wall there; README, SLAM.)
         near = local_seen_.notBehindOf(near, predicted, params_.delta, kWallBehind, normals);
       }
     }

@@ -137,6 +137,8 @@ struct GraphSlamParams {
   /// maps' walls came out at 99.5% on average (98.4-98.7% without), the worst 95.6-95.8%
   /// (86.1-88.9%); FR079 unchanged, but ACES's online pose 0.071-0.089 m (0.053-0.070 m) over 4
   /// draws, so it is off by default and `explore.launch` (the simulated worlds) turns it on.
+  /// When fewer than half the returns pass, tracking takes all but those on the other face of a
+  /// wall the local map saw from its far side (Visibility::notBehindOf).
   bool local_visible_side = false;
   int submap_nodes = 10;            ///< nodes per loop-closure submap (`~submap_nodes`)
   /// [m] The search radius, the window of a closure's search: how far the estimate may have
