@@ -338,6 +338,30 @@ def test_a_frontier_still_there_after_its_goal_was_reached_is_given_up_not_chase
     assert t.screen(11.0, [again])[0] == [again]
 
 
+def test_a_frontier_still_there_where_the_robot_stood_gets_its_next_goal_elsewhere():
+    # A room with its door in the east wall and, beside the door, a corner of floor the robot did
+    # not see from the doorway (the home's kitchen). The robot came from the hall east of it.
+    m = room(width_m=4.0, height_m=3.0, door=(1.0, 2.0), unknown_beyond=False)
+    m.data[int(1.05 / RES):int(1.95 / RES), int(3.5 / RES):int(4.95 / RES)] = -1
+    c = costmap_of(m)
+    s = ExploreState()
+    first = rank_frontiers(m, c, (6.5, 2.5), min_unknown_area=3.0)
+    assert len(first) == 1 and s.choose(0.0, first, (6.5, 2.5)) is first[0]
+    s.reached(30.0, arrived=True)
+    # the map made there still has the corner unknown: the next goal is not where the robot stands
+    again = rank_frontiers(m, c, first[0].goal, min_unknown_area=3.0, avoid=s.avoid(33.0),
+                           avoid_radius=s.blacklist_radius, avoid_goals=s.avoid_goals(33.0))
+    assert len(again) == 1
+    assert math.hypot(again[0].goal[0] - first[0].goal[0], again[0].goal[1] - first[0].goal[1]) >= s.blacklist_radius - RES
+    eligible, waiting, given_up = s.screen(33.0, again, map_time=32.0)
+    assert eligible == again and given_up == []
+    assert s.choose(33.0, eligible, first[0].goal) is again[0]
+    # stood at twice and still there: given up, with why
+    s.reached(50.0, arrived=True)
+    eligible, waiting, given_up = s.screen(53.0, again, map_time=52.0)
+    assert eligible == [] and 'reached 2 times' in given_up[0].why
+
+
 def test_two_frontiers_pulling_the_robot_to_and_fro_end_after_max_goals_per_place():
     # A is near and cheap but never gets explored (its goal is "reached" each time from afar and
     # its cells move a little); B is far. Greedy choice alone would alternate forever (the office
