@@ -353,6 +353,7 @@ def test_a_frontier_still_there_where_the_robot_stood_gets_its_next_goal_elsewhe
                            avoid_radius=s.blacklist_radius, avoid_goals=s.avoid_goals(33.0))
     assert len(again) == 1
     assert math.hypot(again[0].goal[0] - first[0].goal[0], again[0].goal[1] - first[0].goal[1]) >= s.blacklist_radius - RES
+    assert again[0].goal[0] < 5.0  # in the room: not in the hall across the wall from the corner
     eligible, waiting, given_up = s.screen(33.0, again, map_time=32.0)
     assert eligible == again and given_up == []
     assert s.choose(33.0, eligible, first[0].goal) is again[0]
@@ -360,6 +361,21 @@ def test_a_frontier_still_there_where_the_robot_stood_gets_its_next_goal_elsewhe
     s.reached(50.0, arrived=True)
     eligible, waiting, given_up = s.screen(53.0, again, map_time=52.0)
     assert eligible == [] and 'reached 2 times' in given_up[0].why
+
+
+def test_a_sliver_of_unknown_the_laser_grazed_is_not_worth_a_trip_but_the_grids_edge_is():
+    m = room(width_m=4.0, height_m=3.0, door=(1.0, 2.0), unknown_beyond=False)
+    m.data[int(2.5 / RES), int(2.0 / RES):int(3.2 / RES)] = -1   # one row of cells, 1.2 m: 0.06 m^2
+    m.data[int(2.0 / RES):int(3.0 / RES), -1] = -1                  # at the SLAM map's east edge: 0.05 m^2
+                                                                    # in the grid, and what lies beyond it
+    c = costmap_of(m)
+    assert len(rank_frontiers(m, c, (2.0, 2.0))) == 2
+    unreachable = []
+    f = rank_frontiers(m, c, (2.0, 2.0), min_unknown_beside=0.25, unreachable=unreachable)
+    assert len(f) == 1 and np.all(f[0].cells[:, 0] > 7.8)          # the edge
+    assert f[0].unknown_m2 > 1.0
+    assert len(unreachable) == 1 and 'only 0.06 m^2 unknown' in unreachable[0].why
+    assert unreachable[0].as_dict()['y'] == pytest.approx(2.5, abs=0.1)
 
 
 def test_two_frontiers_pulling_the_robot_to_and_fro_end_after_max_goals_per_place():

@@ -29,7 +29,8 @@ potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), m
 transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
 hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space
 smaller than this, the inside of furniture, makes no frontier unless free floor bounds most of it:
-then it is floor in a shadow), tour_frontiers (20: the frontiers re-ranked by the
+then it is floor in a shadow), min_unknown_beside (0.25 m^2: a frontier with less unknown space
+within 1 m of it is given up, a sliver the laser grazed), tour_frontiers (20: the frontiers re-ranked by the
 shortest tour through the goals of the 20 best, frontiers.tour_order, so that the robot finishes one
 side before it crosses to the other, and takes a small frontier it passes rather than coming back
 for it; at most 40; 0 or 1: explore_lite's greedy choice; a team's robots choose greedily),
@@ -129,6 +130,7 @@ class Explore:
             rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
         self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
         self.min_unknown_area = r.number('min_unknown_area', 3.0, minimum=0.0)
+        self.min_unknown_beside = r.number('min_unknown_beside', 0.25, minimum=0.0)
         self.tour_frontiers = r.integer('tour_frontiers', 20, minimum=0)
         if self.tour_frontiers > MAX_TOUR_FRONTIERS:
             # a tour beyond 12 goals costs about n^4 steps and a path-length field per goal: 5 ms at
@@ -498,7 +500,8 @@ class Explore:
                                 self.gain_scale, avoid, self.state.blacklist_radius,
                                 min_unknown_area=self.min_unknown_area, stats=stats,
                                 avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
-                                keep_goal=self.state.goal.goal if self.state.goal is not None else None)
+                                keep_goal=self.state.goal.goal if self.state.goal is not None else None,
+                                min_unknown_beside=self.min_unknown_beside)
         frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats
