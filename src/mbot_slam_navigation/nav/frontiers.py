@@ -267,13 +267,15 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                 and _sees(cost, (int(kr), int(kc)), fcells)):
             gr, gc = int(kr), int(kc)
         else:
-            # the nearest by path that sees the frontier (nearly always the first one tried)
+            # the nearest by path that sees the frontier (nearly always the first one tried; the
+            # window of a long frontier holds 10^5 cells, too many to sort every cycle)
             gr = gc = -1
-            for w in np.argsort(d, axis=None)[:int(np.count_nonzero(candidates))]:
-                wr, wc = np.unravel_index(int(w), d.shape)
+            for _ in range(int(np.count_nonzero(candidates))):
+                wr, wc = np.unravel_index(int(np.argmin(d)), d.shape)
                 if _sees(cost, (int(wr + r0), int(wc + c0)), fcells):
                     gr, gc = int(wr + r0), int(wc + c0)
                     break
+                d[wr, wc] = np.inf
             if gr < 0:
                 if unreachable is not None:
                     unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
