@@ -263,19 +263,30 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             continue
         d = np.where(candidates, dist[r0:r1, c0:c1], np.inf)
         fcells = np.column_stack([cr[inside], cc[inside]])
+        # an obstacle the costmap has on a frontier cell (seen since the map was made) blocks no view
+        # of the others
+        clear = cost[fcells[:, 0], fcells[:, 1]] < 100
+        if clear.any():
+            fcells = fcells[clear]
         if (r0 <= kr < r1 and c0 <= kc < c1 and candidates[kr - r0, kc - c0]
                 and _sees(cost, (int(kr), int(kc)), fcells)):
             gr, gc = int(kr), int(kc)
         else:
-            # the nearest by path that sees the frontier (nearly always the first one tried; the
-            # window of a long frontier holds 10^5 cells, too many to sort every cycle)
+            # the nearest by path that sees the frontier, tried 32 at a time (the window of a long
+            # frontier holds 10^5 cells, too many to sort every cycle; measured in the office: in
+            # 4 cycles of 10 the first one tried is across a wall, a corridor's cells beside a room)
             gr = gc = -1
-            for _ in range(int(np.count_nonzero(candidates))):
-                wr, wc = np.unravel_index(int(np.argmin(d)), d.shape)
-                if _sees(cost, (int(wr + r0), int(wc + c0)), fcells):
-                    gr, gc = int(wr + r0), int(wc + c0)
-                    break
-                d[wr, wc] = np.inf
+            flat, left = d.ravel(), int(np.count_nonzero(candidates))
+            while gr < 0 and left > 0:
+                k = min(32, left)
+                batch = np.argpartition(flat, k - 1)[:k] if k < flat.size else np.arange(flat.size)
+                for w in batch[np.argsort(flat[batch])]:
+                    wr, wc = np.unravel_index(int(w), d.shape)
+                    if _sees(cost, (int(wr + r0), int(wc + c0)), fcells):
+                        gr, gc = int(wr + r0), int(wc + c0)
+                        break
+                    flat[w] = np.inf
+                left -= k
             if gr < 0:
                 if unreachable is not None:
                     unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
