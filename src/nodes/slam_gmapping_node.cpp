@@ -387,9 +387,13 @@ class SlamGmappingNode {
     }
     // A map rebuild and an optimization allocate and free megabytes; glibc keeps freed pages in
     // the middle of the heap, so a node left running for hours would show its peaks, not its use.
-    // Only when much is free: every page given back faults in again when the next grid is built
-    // (trimmed after every map, the page faults took 2% of the node's CPU on ACES).
-    if (mallinfo2().fordblks > kTrimFreeBytes) malloc_trim(0);
+    // Once a minute, or at once when much is free: every page given back faults in again when the
+    // next grid is built (trimmed after every map, the page faults took 2% of the node's CPU on ACES).
+    if (mallinfo2().fordblks > kTrimFreeBytes || last_trim_.isZero() || stamp < last_trim_ ||
+        (stamp - last_trim_).toSec() >= kTrimPeriod) {
+      malloc_trim(0);
+      last_trim_ = stamp;
+    }
   }
 
   bool onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
@@ -447,7 +451,8 @@ class SlamGmappingNode {
   std::mutex mutex_, map_mutex_;
   // Stamps of map -> odom lately sent by the broadcast loop and by the scan callback (stamp_mutex_).
   static constexpr std::size_t kStampMemory = 256;
-  static constexpr std::size_t kTrimFreeBytes = 64u << 20;  // free heap [bytes] worth giving back
+  static constexpr std::size_t kTrimFreeBytes = 64u << 20;  // free heap [bytes] given back at once
+  static constexpr double kTrimPeriod = 60.0;                 // [s] between trims otherwise
   static constexpr double kMaxScanTransformAge = 5.0;  // [s]
   std::mutex stamp_mutex_;
   std::deque<ros::Time> loop_stamps_, scan_stamps_;
@@ -461,6 +466,7 @@ class SlamGmappingNode {
   long scan_count_ = 0;
   static constexpr double kSummaryPeriod = 300.0;  // [s]
   ros::Time last_summary_;
+  ros::Time last_trim_;  // when the heap was last trimmed (publishMap)
   std::thread tf_thread_;
 };
 

@@ -168,8 +168,9 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     0..100: clear of the inflated zone, so move_base will not refuse it as occupied when the
     obstacle behind the frontier shows up), and not within avoid_radius of a point in
     `avoid_goals` (goals that failed, or where the robot stood with the frontier still there:
-    whatever shape the frontier has now, that goal is not sent again). Frontiers large enough but with no such cell, or large enough only with the cells near
-    `avoid`, are appended to `unreachable`, with why. A frontier for which `keep_goal` (the goal
+    whatever shape the frontier has now, that goal is not sent again), and seeing the frontier
+    (_sees: not across a wall from it). Frontiers large enough but with no such cell, or large
+    enough only with the cells near `avoid`, are appended to `unreachable`, with why. A frontier for which `keep_goal` (the goal
     being driven to) is still such a cell keeps it as its goal: the cell nearest by path changes
     as the robot moves, and a goal that jumps from one end of a frontier to the other and back
     sends the robot to and fro (measured: 1.1 m apart, every 10-20 s, for 90 s at the home's
@@ -278,15 +279,15 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             gr = gc = -1
             flat, left = d.ravel(), int(np.count_nonzero(candidates))
             while gr < 0 and left > 0:
-                k = min(32, left)
-                batch = np.argpartition(flat, k - 1)[:k] if k < flat.size else np.arange(flat.size)
+                n_try = min(32, left)
+                batch = np.argpartition(flat, n_try - 1)[:n_try] if n_try < flat.size else np.arange(flat.size)
                 for w in batch[np.argsort(flat[batch])]:
                     wr, wc = np.unravel_index(int(w), d.shape)
                     if _sees(cost, (int(wr + r0), int(wc + c0)), fcells):
                         gr, gc = int(wr + r0), int(wc + c0)
                         break
                     flat[w] = np.inf
-                left -= k
+                left -= n_try
             if gr < 0:
                 if unreachable is not None:
                     unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
