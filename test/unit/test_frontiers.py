@@ -239,6 +239,19 @@ def test_floor_in_a_shadow_makes_a_frontier_though_small_and_enclosed():
     assert len(frontier_groups(k, min_unknown_area=3.0)) == 2  # the shadow, and the unknown band along the edge
 
 
+def test_a_corner_in_the_shadow_of_a_door_jamb_makes_a_frontier_though_walls_hold_most_of_its_rim():
+    # A right triangle of unknown floor in a room's corner, against two walls (legs 1.5 and 1.2 m):
+    # under half of its rim is open floor, but that part is one straight edge 1.9 m long (the
+    # home's kitchen beside its door). A table seen from one side is bounded by its faces instead.
+    m = room(width_m=4.0, height_m=3.0)
+    rows, cols = np.indices(m.data.shape)
+    x, y = (cols + 0.5) * RES, (rows + 0.5) * RES
+    corner = (x > 1.05) & (y > 1.05) & ((x - 1.0) / 1.5 + (y - 1.0) / 1.2 < 1.0)
+    m.data[corner] = -1
+    groups = frontier_groups(m, min_unknown_area=3.0)
+    assert len(groups) == 1 and len(groups[0]) * RES > 1.2  # 28 cells along the diagonal
+
+
 def test_a_robot_inside_the_inscribed_zone_still_reaches_out_and_reachable_area_is_reported():
     m = room(door=(1.0, 2.0))
     m.data[int(2.0 / RES):int(2.4 / RES), int(2.12 / RES)] = 100  # a post 0.12 m east of the robot
