@@ -80,8 +80,8 @@ def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0
     pillar, which no sensor sees. Enclosed unknown space bounded mostly by free cells, and of at
     least a tenth of min_unknown_area, still does: it is floor in a shadow (the part of a room
     beside its door that the robot did not see from the doorway; measured: the home's kitchen left
-    71% mapped, its shadow of about 1.5 m^2 taken for furniture). So does one with a piece of open
-    rim SHADOW_EDGE long: a shadow's edge is one straight line of floor, and a corner's shadow
+    71% mapped, its shadow of about 1.5 m^2 taken for furniture). So does one with a connected piece of open
+    rim SHADOW_EDGE across: a shadow's edge is one line of floor, and a corner's shadow
     against two walls has only 41-50% of its rim open (the kitchen's corner: 38% in cells, its edge
     1.4-2.6 m; the home's table and bathroom object, seen round, 1.0-1.2 m).
     """
@@ -111,7 +111,7 @@ def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0
     return unknown
 
 
-SHADOW_EDGE = 1.3  # [m] an enclosed unknown region with a straight piece of open rim this long is floor
+SHADOW_EDGE = 1.3  # [m] an enclosed unknown region with a connected piece of open rim this wide is floor
 
 
 def _longest_piece(mask: np.ndarray) -> float:
