@@ -7,6 +7,8 @@
 #include <string>
 #include <unordered_set>
 
+#include <Eigen/Geometry>
+
 #include "mbot_slam_navigation/core/cell.h"
 #include "mbot_slam_navigation/core/pose2d.h"
 
@@ -244,14 +246,12 @@ std::vector<Eigen::Vector2d> Visibility::seenOf(const std::vector<Eigen::Vector2
                                                double tolerance_m, const std::vector<Eigen::Vector2d>* normals) const {
   std::vector<Eigen::Vector2d> out;
   out.reserve(points.size());
-  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  const Eigen::Rotation2Dd turn(pose.z());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector2d& p = points[i];
-    const Eigen::Vector2d w(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
-    Eigen::Vector2d side;  // the normal in the reference frame, where the point has one
     const bool has_side = normals && !(*normals)[i].isZero();
-    if (has_side) side << c * (*normals)[i].x() - s * (*normals)[i].y(), s * (*normals)[i].x() + c * (*normals)[i].y();
-    if (seen(w, tolerance_m, has_side ? &side : nullptr)) out.push_back(p);
+    const Eigen::Vector2d side = has_side ? Eigen::Vector2d(turn * (*normals)[i]) : Eigen::Vector2d::Zero();  // reference frame
+    if (seen(pose.head<2>() + turn * p, tolerance_m, has_side ? &side : nullptr)) out.push_back(p);
   }
   return out;
 }
@@ -261,12 +261,12 @@ std::vector<Eigen::Vector2d> Visibility::notBehindOf(const std::vector<Eigen::Ve
                                                     const std::vector<Eigen::Vector2d>& normals) const {
   std::vector<Eigen::Vector2d> out;
   out.reserve(points.size());
-  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  const Eigen::Rotation2Dd turn(pose.z());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector2d& p = points[i];
     if (i < normals.size() && !normals[i].isZero()) {
-      const Eigen::Vector2d w(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
-      const Eigen::Vector2d side(c * normals[i].x() - s * normals[i].y(), s * normals[i].x() + c * normals[i].y());
+      const Eigen::Vector2d w = pose.head<2>() + turn * p;  // reference frame, as in seenOf
+      const Eigen::Vector2d side = turn * normals[i];
       const Eigen::Vector2d back = -side;
       if (!seen(w, tolerance_m, &side) && seen(w, behind_m, &back)) continue;
     }
