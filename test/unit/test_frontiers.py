@@ -101,6 +101,28 @@ def test_nearer_and_larger_frontiers_cost_less():
     assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.75)[0].goal[0] > 6.0  # the gap is too small
 
 
+def test_a_long_frontier_counts_no_more_than_gain_size_max():
+    # A corridor 1.9 m wide and 22 m long, seen from its west end: its north side open from x = 8.5
+    # on (13.5 m of frontier, the edge of the laser's view), a 1 m gap in its north wall at x 1.5..2.5
+    # behind the robot (x 4). Uncapped, the long frontier 4.5 m away outweighs the gap 2 m away (the
+    # office's lobby corners were left for last that way); counted up to 5 m, the gap goes first.
+    g = np.full((int(5 / RES), int(24 / RES)), -1, np.int8)
+    r0, r1, c0, c1 = int(1 / RES), int(3 / RES), int(1 / RES), int(23 / RES)
+    g[r0:r1 + 1, c0:c1 + 1] = 100
+    g[r0 + 1:r1, c0 + 1:c1] = 0
+    g[r1, int(1.5 / RES):int(2.5 / RES)] = 0   # the gap
+    g[r1, int(8.5 / RES):c1] = 0               # the open side
+    m = Grid(g, RES, (0.0, 0.0))
+    c = costmap_of(m)
+    uncapped = rank_frontiers(m, c, (4.0, 2.0), min_frontier_size=0.5)
+    assert len(uncapped) == 2
+    assert uncapped[0].size_m > 10.0 and uncapped[0].goal[0] > 8.0
+    capped = rank_frontiers(m, c, (4.0, 2.0), min_frontier_size=0.5, gain_size_max=5.0)
+    assert capped[0].goal[0] < 3.0 and capped[0].size_m < 1.5
+    assert capped[1].size_m == pytest.approx(uncapped[0].size_m)  # the size itself is kept
+    assert capped[1].cost == pytest.approx(3.0 * capped[1].path_m - 5.0)
+
+
 def test_blacklisted_places_are_avoided():
     m = room(door=(1.0, 2.0))
     c = costmap_of(m)

@@ -2,7 +2,7 @@
 
 Every 1/planner_frequency seconds: frontiers of the SLAM map, each one's goal = its cell nearest to
 the robot by path on move_base's global costmap (so never inside an obstacle, never unreachable),
-cost = potential_scale * path length - gain_scale * frontier size; the current goal is kept unless
+cost = potential_scale * path length - gain_scale * frontier size (counted up to gain_size_max); the current goal is kept unless
 another beats it by `hysteresis`, and a goal left for a better one does not take the robot back
 from the current one for `switch_back_after` (60 s; as the map grows two frontiers' costs can take
 turns, and the robot would reach neither); a goal move_base aborts, or one the robot makes no progress
@@ -26,7 +26,9 @@ explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
 (move_base/global_costmap/costmap), planner_frequency (0.33 Hz), progress_timeout (30 s),
 potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
 (0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
-transform_tolerance (0.3 s). Ours: map_topic (map), blacklist_timeout (60 s), max_tries (2),
+transform_tolerance (0.3 s). Ours: map_topic (map), gain_size_max (5 m: a frontier's size counts
+in its gain up to this, so that the edge of the laser's view down a long corridor does not
+outweigh the frontiers behind the robot; 0: no cap), blacklist_timeout (60 s), max_tries (2),
 hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space
 smaller than this, the inside of furniture, makes no frontier unless free floor bounds most of it:
 then it is floor in a shadow), min_unknown_beside (0.25 m^2: a frontier with less unknown space
@@ -126,6 +128,7 @@ class Explore:
         self.period = 1.0 / r.number('planner_frequency', 0.33, positive=True)
         self.potential_scale = r.number('potential_scale', 3.0, minimum=0.0)
         self.gain_scale = r.number('gain_scale', 1.0, minimum=0.0)
+        self.gain_size_max = r.number('gain_size_max', 5.0, minimum=0.0)
         if r.number('orientation_scale', 0.0) != 0.0:
             rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
         self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
@@ -484,9 +487,10 @@ class Explore:
                     return 'complete'
             if now >= next_print:
                 next_print = now + self.progress_period
-                print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), %.0f s simulated in %.0f s '
-                      'wall' % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
-                                self.goals_failed(), now, time.monotonic() - wall0), flush=True)
+                print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), robot at (%.2f, %.2f), '
+                      '%.0f s simulated in %.0f s wall'
+                      % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
+                         self.goals_failed(), pose[0], pose[1], now, time.monotonic() - wall0), flush=True)
             self.wait_cycle()
         return None
 
@@ -501,7 +505,7 @@ class Explore:
                                 min_unknown_area=self.min_unknown_area, stats=stats,
                                 avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
                                 keep_goal=self.state.goal.goal if self.state.goal is not None else None,
-                                min_unknown_beside=self.min_unknown_beside)
+                                min_unknown_beside=self.min_unknown_beside, gain_size_max=self.gain_size_max)
         frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats

@@ -51,7 +51,7 @@ class Frontier:
     size_m: float            # N x resolution
     goal: Tuple[float, float]
     path_m: float            # path length from the robot to the goal [m]
-    cost: float              # potential_scale * path_m - gain_scale * size_m (lower is better)
+    cost: float              # potential_scale * path_m - gain_scale * min(size_m, gain_size_max) (lower is better)
     unknown_m2: float = math.inf  # [m^2] unknown space within GAIN_RADIUS of its cells (what it may show)
 
 
@@ -177,7 +177,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                    stats: Optional[dict] = None, avoid_goals: Sequence[Tuple[float, float]] = (),
                    unreachable: Optional[List[GivenUp]] = None,
                    keep_goal: Optional[Tuple[float, float]] = None,
-                   min_unknown_beside: float = 0.0) -> List[Frontier]:
+                   min_unknown_beside: float = 0.0, gain_size_max: float = 0.0) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
@@ -195,6 +195,11 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     last frontier). A frontier with less than min_unknown_beside [m^2] of unknown space within
     GAIN_RADIUS of its cells (Frontier.unknown_m2; beyond the grid's edge counts as unknown) goes to
     `unreachable` too: it is not worth a trip.
+
+    A frontier's size counts in its cost up to gain_size_max [m] (0: no cap). Uncapped, the edge of
+    the laser's view down a corridor (60 m of frontier in the office, seen from its lobby) outweighs
+    20 m of path, and the lobby's corners behind the robot were left for last: 19 m back across the
+    floor at the end, a plateau of over a minute.
     """
     rr, rc = costmap.cell_of(robot[0], robot[1])
     if not costmap.inside(rr, rc):
@@ -316,7 +321,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
         gx, gy = costmap.centre_of(gr, gc)
         path_m = float(d[gr - r0, gc - c0]) * costmap.resolution
         out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
-                            potential_scale * path_m - gain_scale * size, unknown_m2))
+                            potential_scale * path_m - gain_scale * (min(size, gain_size_max) if gain_size_max > 0
+                                                                     else size), unknown_m2))
     return sorted(out, key=lambda f: f.cost)
 
 
