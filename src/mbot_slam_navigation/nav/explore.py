@@ -2,14 +2,15 @@
 
 Every 1/planner_frequency seconds: frontiers of the SLAM map, each one's goal = its cell nearest to
 the robot by path on move_base's global costmap (so never inside an obstacle, never unreachable),
-cost = potential_scale * path length - gain_scale * frontier size (counted up to gain_size_max); the current goal is kept unless
-another beats it by `hysteresis`, and a goal left for a better one does not take the robot back
-from the current one for `switch_back_after` (60 s; as the map grows two frontiers' costs can take
-turns, and the robot would reach neither); a goal move_base aborts, or one the robot makes no progress
-towards within progress_timeout, is blacklisted for blacklist_timeout with its frontier (after
-max_tries failures that frontier is given up, whatever goal it yields next); a goal reached is not
-sent again, and frontier cells near it count only when nothing else is left and their frontier is
-at least twice min_frontier_size (a room seen only from its door). Every run ends, with an outcome:
+cost = potential_scale * path length - gain_scale * frontier size (counted up to gain_size_max); the
+current goal is kept unless another beats it by `hysteresis`, and a goal left for a better one does
+not take the robot back from the current one for `switch_back_after` (60 s; as the map grows two
+frontiers' costs can take turns, and the robot would reach neither); a goal move_base aborts, or one
+the robot makes no progress towards within progress_timeout, is blacklisted for blacklist_timeout
+with its frontier (after max_tries failures that frontier is given up, whatever goal it yields
+next); a goal reached is not sent again, and frontier cells near it count only when nothing else
+is left and their frontier is at least twice min_frontier_size (a room seen only from its door).
+Every run ends, with an outcome:
 - `complete`: no reachable frontier left (frontiers given up or unreachable are listed in the report);
 - `timeout`: max_duration [simulated s] passed (0: no limit);
 - `stuck`: goals fail, the robot has not moved for progress_timeout and move_base cannot move it;
