@@ -45,6 +45,11 @@ def spin(stop_at):
         pass
 
 
+def world_tag(world, seed):
+    """The name of a world's runs: the world, with the seed when it was generated with one."""
+    return world if seed is None or world == 'home' else '%s_seed%d' % (world, seed)
+
+
 def world_path(world, seed):
     """The world file to explore: the committed one, or (seed given, not the home) one generated
     with that seed."""
@@ -59,7 +64,7 @@ def world_path(world, seed):
 
 
 def one_run(world, load, k, log_dir, seed=None):
-    tag = world if seed is None or world == 'home' else '%s_seed%d' % (world, seed)
+    tag = world_tag(world, seed)
     out = os.path.join(HERE, 'out', 'explore_%s_%s_%d' % (tag, load, k))
     shutil.rmtree(out, ignore_errors=True)
     env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % PORT)
@@ -102,7 +107,7 @@ def main():
     failed = False
     for world in worlds:
         runs = int(os.environ.get('BENCH_EXPLORE_RUNS', '5' if world == 'home' else '2'))
-        label = world if seed is None or world == 'home' else '%s_seed%d' % (world, seed)
+        label = world_tag(world, seed)
         for load in loads:
             reports = [one_run(world, load, k, log_dir, seed) for k in range(1, runs + 1)]
             done = [r for r in reports if r]

@@ -105,7 +105,7 @@ def test_a_long_frontier_counts_no_more_than_gain_size_max():
     # A corridor 1.9 m wide and 22 m long, seen from its west end: its north side open from x = 8.5
     # on (13.5 m of frontier, the edge of the laser's view), a 1 m gap in its north wall at x 1.5..2.5
     # behind the robot (x 4). Uncapped, the long frontier 4.5 m away outweighs the gap 2 m away (the
-    # office's lobby corners were left for last that way); counted up to 5 m, the gap goes first.
+    # office's lobby behind the start was left for last that way); counted up to 5 m, the gap goes first.
     g = np.full((int(5 / RES), int(24 / RES)), -1, np.int8)
     r0, r1, c0, c1 = int(1 / RES), int(3 / RES), int(1 / RES), int(23 / RES)
     g[r0:r1 + 1, c0:c1 + 1] = 100

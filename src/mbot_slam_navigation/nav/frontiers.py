@@ -43,6 +43,7 @@ class Grid:
 
 
 GAIN_RADIUS = 1.0  # [m] around a frontier's cells: the unknown space it borders (Frontier.unknown_m2)
+SHADOW_EDGE = 1.3  # [m] an enclosed unknown region with a connected piece of open rim this wide is floor
 
 
 @dataclass
@@ -80,10 +81,10 @@ def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0
     pillar, which no sensor sees. Enclosed unknown space bounded mostly by free cells, and of at
     least a tenth of min_unknown_area, still does: it is floor in a shadow (the part of a room
     beside its door that the robot did not see from the doorway; measured: the home's kitchen left
-    71% mapped, its shadow of about 1.5 m^2 taken for furniture). So does one with a connected piece of open
-    rim SHADOW_EDGE across: a shadow's edge is one line of floor, and a corner's shadow
-    against two walls has only 41-50% of its rim open (the kitchen's corner: 38% in cells, its edge
-    1.4-2.6 m; the home's table and bathroom object, seen round, 1.0-1.2 m).
+    71% mapped, its shadow of about 1.5 m^2 taken for furniture). So does one with a connected
+    piece of open rim SHADOW_EDGE across: a shadow's edge is one line of floor, and a corner's
+    shadow against two walls has only 41-50% of its rim open (the kitchen's corner: 38% in cells,
+    its edge 1.4-2.6 m; the home's table and bathroom object, seen round, 1.0-1.2 m).
     """
     data = m.data.astype(np.int16)
     unknown = (data < 0).astype(np.uint8)
@@ -105,13 +106,10 @@ def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0
             inside = (labels[r0:r1, c0:c1] == i).astype(np.uint8)
             ring = (cv2.dilate(inside, cross) > 0) & (inside == 0)
             open_rim = ring & open_known[r0:r1, c0:c1]
-            keep[i] = np.count_nonzero(open_rim) >= 0.5 * np.count_nonzero(ring) or \
-                _longest_piece(open_rim) * m.resolution >= SHADOW_EDGE
+            keep[i] = (np.count_nonzero(open_rim) >= 0.5 * np.count_nonzero(ring)
+                       or _longest_piece(open_rim) * m.resolution >= SHADOW_EDGE)
         unknown = keep[labels].astype(np.uint8)
     return unknown
-
-
-SHADOW_EDGE = 1.3  # [m] an enclosed unknown region with a connected piece of open rim this wide is floor
 
 
 def _longest_piece(mask: np.ndarray) -> float:
@@ -320,9 +318,9 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                 continue
         gx, gy = costmap.centre_of(gr, gc)
         path_m = float(d[gr - r0, gc - c0]) * costmap.resolution
+        gain = min(size, gain_size_max) if gain_size_max > 0 else size
         out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
-                            potential_scale * path_m - gain_scale * (min(size, gain_size_max) if gain_size_max > 0
-                                                                     else size), unknown_m2))
+                            potential_scale * path_m - gain_scale * gain, unknown_m2))
     return sorted(out, key=lambda f: f.cost)
 
 
