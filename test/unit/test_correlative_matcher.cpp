@@ -181,6 +181,44 @@ TEST(CorrelativeMatcher, CellsTellDistancesOfAMillimetreNearAPoint) {
   }
 }
 
+
+TEST(CorrelativeMatcher, EachPooledLevelHoldsTheMaximumOfItsBlockAndCellsTheKernel) {
+  // The branch and bound's bounds are only bounds if every pooled value is the largest level-0
+  // value of its block (the pyramid is built two halves at a time); a cell holds the largest
+  // kernel value exp(-d^2 / 2 sigma^2) of the points near it, rounded to the grid's integers.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 12; ++i) points.emplace_back(u(rng), 0.5 * u(rng));
+  const double res = 0.05, sigma = 0.075;
+  const LikelihoodGrid grid(points, res, sigma);
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      double best = 0.0;
+      for (const auto& p : points) {  // the kernel reaches r = ceil(3 sigma / res) cells each way
+        const Cell c = worldToCell(grid.origin(), res, p);
+        if (std::abs(c.x - x) > 5 || std::abs(c.y - y) > 5) continue;
+        const double d = (cellCenter(grid.origin(), res, {x, y}) - p).norm();
+        best = std::max(best, std::exp(-d * d / (2.0 * sigma * sigma)));
+      }
+      ASSERT_NEAR(grid.value(x, y), LikelihoodGrid::kMax * best, 1.0) << "cell " << x << ", " << y;
+    }
+  }
+  grid.buildLevels(5);
+  for (int h = 1; h < 5; ++h) {
+    const int side = 1 << h;
+    for (int y = -side + 1; y < grid.height(); ++y) {
+      for (int x = -side + 1; x < grid.width(); ++x) {
+        int best = 0;
+        for (int dy = 0; dy < side; ++dy)
+          for (int dx = 0; dx < side; ++dx) best = std::max(best, grid.value(x + dx, y + dy));
+        ASSERT_EQ(grid.pooled(h, x, y), best) << "level " << h << " at " << x << ", " << y;
+      }
+    }
+    EXPECT_EQ(grid.pooled(h, grid.width(), 0), 0);  // outside the level
+    EXPECT_EQ(grid.pooled(h, -side, 0), 0);
+  }
+}
 TEST(CorrelativeMatcher, SurfaceNormalsFaceTheLaserAndAreUnknownAtEdges) {
   // A wall along y = 1 seen from the origin, then one point 1 m off it (a depth edge).
   std::vector<Eigen::Vector2d> pts;

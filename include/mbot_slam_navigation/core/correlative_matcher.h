@@ -53,9 +53,27 @@ class LikelihoodGrid {
   /// Mean interpolated value of the points moved by `pose`, in [0, 1] (0 for no points).
   double score(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& pose) const;
 
-  /// Max-pooled level h (h >= 1): value at (x, y) is the largest level-0 value in the block
-  /// [x, x + 2^h) x [y, y + 2^h); x and y may be as low as -(2^h - 1). Built on first use.
-  int pooled(int level, int x, int y) const;
+  /// Level h of the max-pooling pyramid as an array: level 0 is the grid; in level h >= 1 the
+  /// value at (x, y) is the largest level-0 value in the block [x, x + 2^h) x [y, y + 2^h), stored
+  /// at index (y + pad) * width + x + pad, pad = 2^h - 1 (x and y may be as low as -pad).
+  struct Level {
+    const Value* data;
+    int width, height, pad;
+    /// The value at (x, y); 0 outside.
+    int at(int x, int y) const {
+      x += pad;
+      y += pad;
+      return (x < 0 || y < 0 || x >= width || y >= height) ? 0 : data[static_cast<std::size_t>(y) * width + x];
+    }
+  };
+  /// Level h (built by buildLevels(h + 1) or by the matcher; h = 0 is always there).
+  Level level(int h) const {
+    if (h == 0) return {cells_.data(), width_, height_, 0};
+    const int pad = (1 << h) - 1;
+    return {levels_[h - 1].data(), width_ + pad, height_ + pad, pad};
+  }
+  /// Max-pooled level h: level(h).at(x, y).
+  int pooled(int h, int x, int y) const { return level(h).at(x, y); }
   /// Builds levels 1..levels-1 now (they are otherwise built lazily by the matcher).
   void buildLevels(int levels) const;
   /// Frees the pooled levels (they are rebuilt on the next match). Not thread-safe: a grid is
