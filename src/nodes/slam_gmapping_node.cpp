@@ -167,7 +167,8 @@ class SlamGmappingNode {
     param("loop_solve_chi2", g.loop_solve_chi2);
     g.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
     // The parameters both backends share have gmapping's names; read once above.
-    g.linear_update = p.linear_update;
+    // The graph's own default (graph_slam.h: a node every 0.5 m) unless the user set linearUpdate.
+    if (pnh_.hasParam("linearUpdate")) g.linear_update = p.linear_update;
     g.angular_update = p.angular_update;
     g.temporal_update = p.temporal_update;
     g.delta = p.delta;

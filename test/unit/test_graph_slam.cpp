@@ -495,6 +495,10 @@ GraphSlamParams laneParams() {
   p.matcher.max_range = 6.0;
   p.matcher.max_urange = 6.0;
   p.linear_update = 0.3;  // nodes close enough for the way back to find submaps of the way out
+  // The lanes and the circle below are laid out for a local map of 20 nodes (6 m at 0.3 m): with
+  // the default 40 (12 m) the local map alone spans the way out, and what the closures do (or the
+  // submap just behind it) cannot be seen.
+  p.local_map_nodes = 20;
   p.background = false;
   return p;
 }

@@ -25,7 +25,8 @@ GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
 })
 # The pose graph's own (graph_slam.h; the node reads them under the same private names).
 GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
-    'match_max_range': 30.0, 'match_sigma': 0.075, 'local_match_sigma': -1.0, 'local_map_nodes': 20, 'local_search_window': 0.15,
+    'linearUpdate': 0.5,  # a node every 0.5 m (graph_slam.h), half gmapping's
+    'match_max_range': 30.0, 'match_sigma': 0.075, 'local_match_sigma': -1.0, 'local_map_nodes': 40, 'local_search_window': 0.15,
     'local_search_sigmas': 10.0, 'local_search_max_window': 0.3,
     'local_search_angle': 0.15, 'local_min_score': 0.25, 'local_prior_margin': 0.03,
     'local_prior_weight': 5.0, 'local_prior_points': 130.0, 'local_visible_only': 1, 'local_visible_side': 0, 'submap_nodes': 10, 'loop_search_radius': 1.0,
