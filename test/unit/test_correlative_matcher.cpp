@@ -181,7 +181,6 @@ TEST(CorrelativeMatcher, CellsTellDistancesOfAMillimetreNearAPoint) {
   }
 }
 
-
 TEST(CorrelativeMatcher, EachPooledLevelHoldsTheMaximumOfItsBlockAndCellsTheKernel) {
   // The branch and bound's bounds are only bounds if every pooled value is the largest level-0
   // value of its block (the pyramid is built two halves at a time); a cell holds the largest
@@ -192,12 +191,13 @@ TEST(CorrelativeMatcher, EachPooledLevelHoldsTheMaximumOfItsBlockAndCellsTheKern
   for (int i = 0; i < 12; ++i) points.emplace_back(u(rng), 0.5 * u(rng));
   const double res = 0.05, sigma = 0.075;
   const LikelihoodGrid grid(points, res, sigma);
+  const int r = static_cast<int>(std::ceil(3.0 * sigma / res));  // the kernel's reach [cells] each way
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
       double best = 0.0;
-      for (const auto& p : points) {  // the kernel reaches r = ceil(3 sigma / res) cells each way
+      for (const auto& p : points) {
         const Cell c = worldToCell(grid.origin(), res, p);
-        if (std::abs(c.x - x) > 5 || std::abs(c.y - y) > 5) continue;
+        if (std::abs(c.x - x) > r || std::abs(c.y - y) > r) continue;
         const double d = (cellCenter(grid.origin(), res, {x, y}) - p).norm();
         best = std::max(best, std::exp(-d * d / (2.0 * sigma * sigma)));
       }
@@ -219,6 +219,7 @@ TEST(CorrelativeMatcher, EachPooledLevelHoldsTheMaximumOfItsBlockAndCellsTheKern
     EXPECT_EQ(grid.pooled(h, -side, 0), 0);
   }
 }
+
 TEST(CorrelativeMatcher, SurfaceNormalsFaceTheLaserAndAreUnknownAtEdges) {
   // A wall along y = 1 seen from the origin, then one point 1 m off it (a depth edge).
   std::vector<Eigen::Vector2d> pts;
