@@ -77,6 +77,7 @@ GraphSlam::GraphSlam(const GraphSlamParams& params)
       registrar_(params.matcher, params.delta),
       map_({params.xmin, params.ymin}, {params.xmax, params.ymax}, params.delta) {
   search_window_ = params_.local_search_window;
+  map_.trackWrites();
   if (params_.background) {
     worker_ = std::thread([this] { backgroundLoop(); });
 #ifdef __linux__
@@ -785,6 +786,7 @@ OccupancyImage GraphSlam::occupancy(double occ_thresh) const {
   }
   if (map_dirty_) {
     map_ = SlamGrid({params_.xmin, params_.ymin}, {params_.xmax, params_.ymax}, params_.delta);
+    map_.trackWrites();
     map_nodes_ = 0;
     map_dirty_ = false;
   }
@@ -792,7 +794,11 @@ OccupancyImage GraphSlam::occupancy(double occ_thresh) const {
     if (scans[k].second) registrar_.registerScan(map_, scans[k].first, *scans[k].second);  // null: trimmed
   }
   map_nodes_ = static_cast<int>(scans.size());
-  return map_.toOccupancy(occ_thresh);
+  // Between optimizations the map only gains the new nodes' scans: redrawn where they wrote.
+  if (occ_thresh != map_image_thresh_) map_image_ = OccupancyImage();
+  map_image_thresh_ = occ_thresh;
+  map_.updateOccupancy(occ_thresh, map_image_);
+  return map_image_;
 }
 
 }  // namespace core

@@ -32,6 +32,7 @@ Eigen::Vector2d SlamGrid::hitMean(const Cell& c) const {
 
 HitCell& SlamGrid::writableCell(const Cell& c) {
   std::shared_ptr<Patch>& p = patches_[static_cast<std::size_t>(c.y >> kPatchBits) * patches_x_ + (c.x >> kPatchBits)];
+  if (tracking_) written_[static_cast<std::size_t>(c.y >> kPatchBits) * patches_x_ + (c.x >> kPatchBits)] = 1;
   if (!p) {
     p = std::make_shared<Patch>();
   } else if (p.use_count() > 1) {
@@ -58,6 +59,10 @@ void SlamGrid::growToInclude(const Eigen::Vector2d& min_m, const Eigen::Vector2d
     }
   }
   patches_ = std::move(grown);
+  if (tracking_) {
+    written_.assign(patches_.size(), 0);
+    all_written_ = true;  // the picture's patch coordinates moved
+  }
   patches_x_ = nx;
   patches_y_ = ny;
   origin_ -= Eigen::Vector2d(add_left, add_bottom) * patch_m;
@@ -90,8 +95,8 @@ void SlamGrid::registerBeam(const Eigen::Vector2d& from, const Eigen::Vector2d& 
   });
 }
 
-OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
-  int px0 = patches_x_, py0 = patches_y_, px1 = -1, py1 = -1;
+void SlamGrid::writtenBox(int& px0, int& py0, int& px1, int& py1) const {
+  px0 = patches_x_, py0 = patches_y_, px1 = -1, py1 = -1;
   for (int py = 0; py < patches_y_; ++py) {
     for (int px = 0; px < patches_x_; ++px) {
       if (!patches_[static_cast<std::size_t>(py) * patches_x_ + px]) continue;
@@ -101,6 +106,24 @@ OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
       py1 = std::max(py1, py);
     }
   }
+}
+
+void SlamGrid::drawPatch(int px, int py, int px0, int py0, double occ_thresh, OccupancyImage& img) const {
+  const Patch* patch = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
+  for (int cy = 0; cy < kPatchSize; ++cy) {
+    int8_t* row = &img.data[static_cast<std::size_t>((py - py0) * kPatchSize + cy) * img.width + (px - px0) * kPatchSize];
+    if (!patch) {
+      std::fill(row, row + kPatchSize, int8_t{-1});
+      continue;
+    }
+    const HitCell* cells = &patch->cells[cy << kPatchBits];
+    for (int cx = 0; cx < kPatchSize; ++cx) row[cx] = cells[cx].visits ? (occupied(cells[cx], occ_thresh) ? 100 : 0) : -1;
+  }
+}
+
+OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
+  int px0, py0, px1, py1;
+  writtenBox(px0, py0, px1, py1);
   OccupancyImage img;
   img.resolution = resolution_;
   if (px1 < 0) return img;
@@ -111,18 +134,47 @@ OccupancyImage SlamGrid::toOccupancy(double occ_thresh) const {
   // Patch by patch: cells of absent patches stay unknown without being looked up one by one.
   for (int py = py0; py <= py1; ++py) {
     for (int px = px0; px <= px1; ++px) {
-      const Patch* patch = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
-      if (!patch) continue;
-      for (int cy = 0; cy < kPatchSize; ++cy) {
-        int8_t* row = &img.data[static_cast<std::size_t>((py - py0) * kPatchSize + cy) * img.width + (px - px0) * kPatchSize];
-        const HitCell* cells = &patch->cells[cy << kPatchBits];
-        for (int cx = 0; cx < kPatchSize; ++cx) {
-          if (cells[cx].visits) row[cx] = occupied(cells[cx], occ_thresh) ? 100 : 0;
-        }
-      }
+      if (patches_[static_cast<std::size_t>(py) * patches_x_ + px]) drawPatch(px, py, px0, py0, occ_thresh, img);
     }
   }
   return img;
+}
+
+void SlamGrid::trackWrites() {
+  if (tracking_) return;
+  tracking_ = true;
+  written_.assign(patches_.size(), 0);
+  all_written_ = true;
+}
+
+void SlamGrid::updateOccupancy(double occ_thresh, OccupancyImage& image) {
+  const double patch_m = kPatchSize * resolution_;
+  bool whole = !tracking_ || all_written_ || image.data.empty() || image.resolution != resolution_;
+  int px0 = 0, py0 = 0, px1 = -1, py1 = -1;
+  if (!whole) {
+    // The picture's patch box, from its origin: patches never move while the grid does not grow.
+    const Eigen::Vector2d at = (image.origin - origin_) / patch_m;
+    px0 = static_cast<int>(std::lround(at.x()));
+    py0 = static_cast<int>(std::lround(at.y()));
+    px1 = px0 + image.width / kPatchSize - 1;
+    py1 = py0 + image.height / kPatchSize - 1;
+    for (std::size_t i = 0; i < written_.size() && !whole; ++i) {
+      if (!written_[i]) continue;
+      const int px = static_cast<int>(i % patches_x_), py = static_cast<int>(i / patches_x_);
+      whole = px < px0 || px > px1 || py < py0 || py > py1;
+    }
+  }
+  if (whole) {
+    image = toOccupancy(occ_thresh);
+  } else {
+    for (std::size_t i = 0; i < written_.size(); ++i) {
+      if (written_[i]) drawPatch(static_cast<int>(i % patches_x_), static_cast<int>(i / patches_x_), px0, py0, occ_thresh, image);
+    }
+  }
+  if (tracking_) {
+    std::fill(written_.begin(), written_.end(), 0);
+    all_written_ = false;
+  }
 }
 
 int SlamGrid::ownedPatches() const {

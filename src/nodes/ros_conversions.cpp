@@ -37,9 +37,9 @@ void toRos(const core::OccupancyGrid& grid, nav_msgs::OccupancyGrid& out) {
   out.data.assign(data.begin(), data.end());
 }
 
-void toRos(const core::OccupancyImage& image, nav_msgs::OccupancyGrid& out) {
+void toRos(core::OccupancyImage&& image, nav_msgs::OccupancyGrid& out) {
   fillInfo(image.width, image.height, image.resolution, image.origin, out.info);
-  out.data.assign(image.data.begin(), image.data.end());
+  out.data = std::move(image.data);  // both std::vector<int8_t>: no copy
 }
 
 std::string describeScanProblem(const sensor_msgs::LaserScan& msg) {

@@ -23,7 +23,7 @@ core::LaserScan fromRos(const sensor_msgs::LaserScan& msg);
 
 /// Fills `out` (data, info) from a grid; the caller sets the header (frame, stamp).
 void toRos(const core::OccupancyGrid& grid, nav_msgs::OccupancyGrid& out);
-void toRos(const core::OccupancyImage& image, nav_msgs::OccupancyGrid& out);
+void toRos(core::OccupancyImage&& image, nav_msgs::OccupancyGrid& out);  // takes the image's cells
 
 /// Empty when the scan's header and ranges are consistent, else a sentence saying what is wrong
 /// (NaN or inf in the beam geometry, range_max <= range_min, no beams, fewer or more beams than

@@ -18,6 +18,8 @@
 #include <mutex>
 #include <thread>
 
+#include <boost/make_shared.hpp>
+
 #include <malloc.h>
 #include <pthread.h>
 
@@ -371,20 +373,22 @@ class SlamGmappingNode {
   }
 
   void publishMap(const ros::Time& stamp) {
-    nav_msgs::OccupancyGrid map;
+    // Published as a shared message: one serialization for every subscriber, and dynamic_map
+    // answers from the same message without another copy of megabytes.
+    auto map = boost::make_shared<nav_msgs::OccupancyGrid>();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!slam_) return;
-      mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), map);
+      mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), *map);
     }
-    map.header.frame_id = map_frame_;
-    map.header.stamp = stamp;
-    map.info.map_load_time = stamp;
+    map->header.frame_id = map_frame_;
+    map->header.stamp = stamp;
+    map->info.map_load_time = stamp;
     {
       std::lock_guard<std::mutex> lock(map_mutex_);
       last_map_ = map;
-      map_pub_.publish(map);
-      meta_pub_.publish(map.info);
+      map_pub_.publish(last_map_);
+      meta_pub_.publish(map->info);
     }
     // A map rebuild and an optimization allocate and free megabytes; glibc keeps freed pages in
     // the middle of the heap, so a node left running for hours would show its peaks, not its use.
@@ -399,8 +403,8 @@ class SlamGmappingNode {
 
   bool onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
     std::lock_guard<std::mutex> lock(map_mutex_);
-    if (last_map_.data.empty()) return false;  // gmapping answers false until it has a map
-    res.map = last_map_;
+    if (!last_map_ || last_map_->data.empty()) return false;  // gmapping answers false until it has a map
+    res.map = *last_map_;
     return true;
   }
 
@@ -462,7 +466,7 @@ class SlamGmappingNode {
   double correction_threshold_ = 0.1;
   std::unique_ptr<mbot::core::SlamBackend> slam_;
   Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
-  nav_msgs::OccupancyGrid last_map_;
+  nav_msgs::OccupancyGrid::ConstPtr last_map_;  // as published; never changed after
   ros::Time last_stamp_, last_map_update_;
   long scan_count_ = 0;
   static constexpr double kSummaryPeriod = 300.0;  // [s]

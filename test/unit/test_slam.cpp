@@ -129,6 +129,47 @@ TEST(SlamGrid, OccupancyImageIsEveryCellsRatioCroppedToTheWrittenPatches) {
   }
 }
 
+// A node publishing its map every few seconds redraws only the patches written since: the picture
+// must be the whole conversion's, whether the new beams land inside the old picture, in patches
+// outside it, or beyond the grid (which grows and shifts every patch's index).
+TEST(SlamGrid, UpdatedOccupancyImageEqualsTheWholeConversionAfterEveryBatchOfBeams) {
+  SlamGrid g({-10, -10}, {10, 10}, 0.05);
+  g.trackWrites();
+  std::mt19937 rng(12);
+  OccupancyImage img;
+  // Batches: small beams near the start (inside the picture), then farther (new patches), then
+  // beyond the grid's first extent (growth), then near the start again.
+  const double spread[] = {1.0, 1.0, 4.0, 1.0, 14.0, 2.0, 2.0};
+  int redrawn_in_place = 0;
+  for (double s : spread) {
+    std::uniform_real_distribution<double> u(-s, s);
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector2d to(u(rng), u(rng));
+      if (to.x() < -9.5 || to.y() < -9.5 || to.x() > 9.5 || to.y() > 9.5) g.growToInclude(to.array() - 1.0, to.array() + 1.0);
+      g.registerBeam({0.02, 0.03}, to, k % 4 != 0);
+    }
+    const std::size_t before = img.data.size();
+    g.updateOccupancy(0.25, img);
+    const OccupancyImage whole = g.toOccupancy(0.25);
+    ASSERT_EQ(img.width, whole.width);
+    ASSERT_EQ(img.height, whole.height);
+    ASSERT_NEAR((img.origin - whole.origin).norm(), 0.0, 1e-9);
+    ASSERT_TRUE(img.data == whole.data) << "after the batch spread " << s;
+    redrawn_in_place += before == img.data.size();
+  }
+  EXPECT_GE(redrawn_in_place, 2);  // the batches near the start were drawn into the old picture
+}
+
+// Without trackWrites the grid knows nothing of what was written: every update is a whole one.
+TEST(SlamGrid, UpdatedOccupancyImageOfAnUntrackedGridIsTheWholeConversion) {
+  SlamGrid g({0, 0}, {4, 4}, 0.05);
+  OccupancyImage img;
+  g.registerBeam({1.0, 1.0}, {3.0, 2.0}, true);
+  g.updateOccupancy(0.25, img);
+  g.registerBeam({1.0, 1.0}, {1.0, 3.5}, true);
+  g.updateOccupancy(0.25, img);
+  EXPECT_TRUE(img.data == g.toOccupancy(0.25).data);
+}
 namespace {
 int shown(const SlamGrid& g, const Eigen::Vector2d& p) {
   const OccupancyImage img = g.toOccupancy(0.25);

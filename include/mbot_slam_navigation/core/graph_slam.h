@@ -371,6 +371,8 @@ class GraphSlam : public SlamBackend {
   mutable std::mutex map_mutex_;  // the map cache
   mutable SlamGrid map_;
   mutable int map_nodes_ = 0;     // nodes registered in map_
+  mutable OccupancyImage map_image_;  // map_'s picture as occupancy() last returned it
+  mutable double map_image_thresh_ = -1.0;
   mutable bool map_dirty_ = false;
 
   std::thread worker_;

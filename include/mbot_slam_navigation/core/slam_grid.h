@@ -101,6 +101,16 @@ class SlamGrid {
 
   /// gmapping's map: a visited cell that is occupied() shows 100, any other visited cell 0.
   OccupancyImage toOccupancy(double occ_thresh) const;
+  /// From now on, records which patches are written (off by default: the particles' grids,
+  /// copied at every resampling, carry no record). updateOccupancy needs it.
+  void trackWrites();
+  /// Brings `image`, this grid's picture at `occ_thresh` as an earlier call left it (or empty),
+  /// up to date, re-reading only the patches written since that call: a SLAM node publishes its
+  /// map every few seconds and a scan writes a few patches of thousands. The whole picture is
+  /// read again when it is empty, has another resolution or extent than the written part of the
+  /// grid (a patch written outside it, the grid grown), or when writes were not tracked.
+  /// The result equals toOccupancy(occ_thresh) as long as occ_thresh is the same in every call.
+  void updateOccupancy(double occ_thresh, OccupancyImage& image);
   /// Patches allocated by this grid alone (not shared with any other grid) and in all.
   int ownedPatches() const;
   int allocatedPatches() const;
@@ -113,12 +123,20 @@ class SlamGrid {
     HitCell cells[kPatchSize * kPatchSize];
   };
   HitCell& writableCell(const Cell& c);
+  /// The written patches' box [px0, px1] x [py0, py1] (px1 < 0 when nothing is written).
+  void writtenBox(int& px0, int& py0, int& px1, int& py1) const;
+  /// Writes patch (px, py)'s cells into `img`, whose cell (0, 0) is patch (px0, py0)'s first.
+  void drawPatch(int px, int py, int px0, int py0, double occ_thresh, OccupancyImage& img) const;
   static const HitCell empty_cell_;
 
   double resolution_;
   Eigen::Vector2d origin_;
   int patches_x_, patches_y_;
   std::vector<std::shared_ptr<Patch>> patches_;  // row-major, nullptr = never written
+  // trackWrites: 1 for each patch written since the last updateOccupancy (as patches_); empty
+  // when not tracking. all_written_: since then the grid grew, or tracking began.
+  std::vector<uint8_t> written_;
+  bool tracking_ = false, all_written_ = true;
 };
 
 }  // namespace core
