@@ -136,6 +136,14 @@ class Recorder:
         return np.array(out)
 
 
+def paced_cpu_of(scans, backend, rate):
+    """CPU seconds of the backend fed the scans at `rate` times their own pace, closures in their
+    thread: the CPU as the node spends it, without ROS."""
+    slam, cpu = run(scans, {}, progress=False, backend=backend, rate=rate, background=True)
+    del slam
+    return cpu
+
+
 def wait_for_subscriber(topic, proc, timeout_s):
     """Waits until some node subscribes `topic` (the SLAM node is ready for the first scan)."""
     import rosgraph
@@ -219,14 +227,9 @@ def main():
             as_bag = [replace(s, angle_min=float(np.float32(s.angle_min)),
                               angle_increment=float(np.float32(s.angle_increment))) for s in scans]
             for backend in backends:
-                paced_cpu = []
-                if paced:
-                    # CPU as the node spends it: fed at the bag's rate, closures in their thread;
-                    # once before the node and once after, so that a machine that slows down or
-                    # speeds up over the minutes of a run weighs on both sides of the ratio.
-                    slam, c = run(as_bag, {}, progress=False, backend=backend, rate=rate, background=True)
-                    del slam
-                    paced_cpu.append(c)
+                # Once before the node and once after, so that a machine that slows down or speeds
+                # up over the minutes of a run weighs on both sides of the ratio.
+                paced_cpu = [paced_cpu_of(as_bag, backend, rate)] if paced else []
                 poses, pubs, reported, cpu, threads, wall, lag = play(name, bag, scans, backend, rate, recorder, env)
                 e = evaluate(poses[:, 0], poses[:, 1:4], relations)
                 np.savetxt(os.path.join(OUT, 'slam_node_%s_%s.traj' % (name, backend)), poses, fmt='%.6f',
@@ -253,9 +256,7 @@ def main():
                     line['note'] += '; offline %.4f m at the end, %.4f +- %.3f m as each scan was processed' % (
                         off.trans_mean, off_online.trans_mean, off_online.trans_std)
                     if paced:
-                        slam, c = run(as_bag, {}, progress=False, backend=backend, rate=rate, background=True)
-                        del slam
-                        paced_cpu.append(c)
+                        paced_cpu.append(paced_cpu_of(as_bag, backend, rate))
                 emit(metric='%s %s online translation error' % (name, backend), value=e.trans_mean, unit='m',
                      target='<= %.3f' % TARGETS[backend], **line)
                 emit(metric='%s %s largest correction at the robot' % (name, backend), value=jump, unit='m',
