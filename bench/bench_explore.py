@@ -6,12 +6,14 @@ explorer's report, RUNS times per world, on a quiet machine and again with one e
 completions, median and worst exploration time, coverage, walls, collisions, longest plateau
 (without new explored area while reachable frontiers remained), wall time, the explorer's CPU
 seconds per simulated second while exploring (its report's figure) and each node's over the whole
-run (start-up, the return and the report included); every run's report is
+run (start-up, the return and the report included), and beside them what an idle rospy node pays
+there (bench/rospy_floor.py: /clock alone, and /clock with the explorer's /tf subscription; two
+more processes, about 0.02 CPU s per simulated second in all); every run's report is
 kept in bench/out/explore_<world>_<load>_<k>/.
 
 Environment: BENCH_EXPLORE_WORLDS (comma-separated, default home,office,apartment,large),
 BENCH_EXPLORE_RUNS (default 5 for the home, 2 elsewhere), BENCH_EXPLORE_LOADS (quiet,busy),
-BENCH_EXPLORE_SEED: the office, apartment and large floor generated afresh with this seed
+BENCH_EXPLORE_FLOOR=0 leaves the rospy floor probes out. BENCH_EXPLORE_SEED: the office, apartment and large floor generated afresh with this seed
 (tools/generate_world.py, into bench/out/worlds_seed<N>/) instead of the committed seed-1 worlds,
 whose layouts the code has been tuned on; the home is the home either way.
 Targets (issue 16): every run complete, coverage >= 97%, walls >= 99% within 0.1 m, 0 collisions;
@@ -72,6 +74,14 @@ def one_run(world, load, k, log_dir, seed=None):
     if load == 'busy':
         busy = multiprocessing.Process(target=spin, args=(time.time() + 7200,), daemon=True)
         busy.start()
+    probes = {}
+    if os.environ.get('BENCH_EXPLORE_FLOOR', '1') != '0':
+        for name, extra in (('clock', []), ('clock_tf', ['--tf'])):
+            path = os.path.join(log_dir, 'floor_%s.json' % name)
+            if os.path.exists(path):
+                os.remove(path)
+            probes[name] = (path, subprocess.Popen([sys.executable, os.path.join(HERE, 'rospy_floor.py'), path] + extra,
+                                                   env=env, stdout=subprocess.DEVNULL))
     try:
         with open(os.path.join(log_dir, 'explore_%s_%s_%d.log' % (tag, load, k)), 'w') as log:
             r = run(['-p', str(PORT), 'mbot_slam_navigation', 'explore.launch',
@@ -80,6 +90,14 @@ def one_run(world, load, k, log_dir, seed=None):
     finally:
         if busy is not None:
             busy.terminate()
+        for path, proc in probes.values():
+            proc.terminate()
+            proc.wait(timeout=30)
+    if r is not None:
+        for name, (path, _) in probes.items():
+            if os.path.exists(path):
+                with open(path) as f:
+                    r['rospy_floor_' + name] = json.load(f)['cpu_s_per_sim_s']
     if r is None:
         print('%s %s run %d: no report' % (tag, load, k), flush=True)
         return None
@@ -133,6 +151,11 @@ def main():
             if exploring:
                 emit(label, load, 'explore CPU per simulated second while exploring', exploring, 'CPU s', '<= 0.015',
                      '%.4f')
+            for name, what in (('clock', '/clock'), ('clock_tf', '/clock and /tf')):
+                floor = [r['rospy_floor_' + name] for r in done if 'rospy_floor_' + name in r]
+                if floor:
+                    emit(label, load, 'idle rospy node with %s, CPU per simulated second' % what, floor, 'CPU s', '',
+                         '%.4f')
             for node, target in (('explore', ''), ('move_base', ''), ('slam_gmapping', ''), ('gazebo', '')):
                 per_s = [r['node_cpu_s'][node] / r['total_time_s'] for r in done if node in r.get('node_cpu_s', {})]
                 if per_s:

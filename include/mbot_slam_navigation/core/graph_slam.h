@@ -56,6 +56,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <list>
@@ -255,8 +256,11 @@ class GraphSlam : public SlamBackend {
   bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s) override;
   Eigen::Vector3d currentPose() const override;
   std::vector<TrajectoryNode> trajectory() const override;
+  /// Safe to call from a thread other than processScan's: the map is built under its own lock from
+  /// node poses copied under the graph's (a rebuild after an optimization moved them can take
+  /// tenths of a second, and processScan does not wait for it).
   OccupancyImage occupancy(double occ_thresh) const override;
-  bool mapOutdated() const override;
+  bool mapOutdated() const override;  ///< does not wait for a rebuild in progress
   int updates() const override;
 
   /// Waits until the background thread has searched every node for closures, then solves the
@@ -282,6 +286,11 @@ class GraphSlam : public SlamBackend {
     bool anchor = false;     // the first node of a kept submap (never merged)
     int parent = -1;         // merged: the live node before it, which it moves with
     Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // merged: its pose in the parent's frame
+    // Where occupancy() last drew its scan (written there, under mutex_): an optimization that
+    // moves it from there by more than half a cell or 0.5 degree, in one solve or over several,
+    // outdates the map.
+    mutable Eigen::Vector3d drawn_pose = Eigen::Vector3d::Zero();
+    mutable bool drawn = false;
   };
   struct TrackedScan {
     double time_s;
@@ -373,7 +382,8 @@ class GraphSlam : public SlamBackend {
   mutable int map_nodes_ = 0;     // nodes registered in map_
   mutable OccupancyImage map_image_;  // map_'s picture as occupancy() last returned it
   mutable double map_image_thresh_ = -1.0;
-  mutable bool map_dirty_ = false;
+  // Read without map_mutex_ (mapOutdated), so that a scan's processing never waits for a rebuild.
+  mutable std::atomic<bool> map_dirty_{false};
 
   std::thread worker_;
 };
