@@ -13,9 +13,10 @@ kept in bench/out/explore_<world>_<load>_<k>/.
 
 Environment: BENCH_EXPLORE_WORLDS (comma-separated, default home,office,apartment,large),
 BENCH_EXPLORE_RUNS (default 5 for the home, 2 elsewhere), BENCH_EXPLORE_LOADS (quiet,busy),
-BENCH_EXPLORE_FLOOR=0 leaves the rospy floor probes out. BENCH_EXPLORE_SEED: the office, apartment and large floor generated afresh with this seed
-(tools/generate_world.py, into bench/out/worlds_seed<N>/) instead of the committed seed-1 worlds,
-whose layouts the code has been tuned on; the home is the home either way.
+BENCH_EXPLORE_FLOOR=0 leaves the rospy floor probes out. BENCH_EXPLORE_SEED: the office, apartment
+and large floor generated afresh with this seed (tools/generate_world.py, into
+bench/out/worlds_seed<N>/) instead of the committed seed-1 worlds, whose layouts the code has been
+tuned on; the home is the home either way.
 Targets (issue 16): every run complete, coverage >= 97%, walls >= 99% within 0.1 m, 0 collisions;
 median exploration <= 360 s (home), <= 600 s (office), <= 1500 s (large); plateau <= 60 s.
 Run inside the devel environment (make bench does that). Takes hours with the defaults.

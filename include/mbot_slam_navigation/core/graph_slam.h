@@ -35,7 +35,7 @@
 //
 // Map. A gmapping counting grid (slam_grid.h) of every node's scan at its optimized pose. Nodes
 // are added as they come; the grid is rebuilt from all nodes only after an optimization moved some
-// node by more than half a cell or 0.5 degree.
+// node by more than half a cell or 0.5 degree from where the grid drew it.
 //
 // A robot left running in one home revisits the same places for hours; memory must not grow with
 // time. A new node within redundant_distance of an older node that keeps its scan, and within
