@@ -180,9 +180,9 @@ TEST(GraphSlam, TheMapIsOutdatedOnlyAfterAnOptimizationMovedNodesSinceItWasDrawn
   ASSERT_GE(slam.stats().optimizations, 1);
 }
 
-// The node draws the map in its own thread while scans go on (a rebuild after an optimization
-// takes tenths of a second on a large floor). Drawn that way throughout two laps, with the loop
-// closed in the background, the map ends as the nodes' scans drawn afresh at their final poses.
+// occupancy() may be called from another thread while scans go on (graph_slam.h); here it is, all
+// along two laps with the loop closed in the background, which draws the map between many solves.
+// The map ends as the nodes' scans drawn afresh at their final poses.
 TEST(GraphSlam, AMapDrawnWhileScansAreProcessedEndsAsTheScansAtTheirFinalPoses) {
   const World2D w = squareCorridor();
   const Drive d = twoLaps();
