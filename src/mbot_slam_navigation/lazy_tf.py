@@ -17,7 +17,8 @@ only the older part of a burst between two lookups, so lookups of the latest tra
 (rospy.Time(0)) answer as a TransformListener's buffer would; a lookup at a past time interpolates
 between the samples kept, which are `keep` per stream per lookup interval. /tf_static is read as a
 TransformListener reads it. Like TransformListener, the buffer is cleared when ROS time jumps back
-(a simulation reset, a bag played again).
+(a simulation reset, a bag played again). With a `read_period`, /tf is read in batches at most
+that often (batched_reads): a lookup then sees what arrived up to that much wall time before.
 """
 import collections
 import struct
@@ -27,6 +28,8 @@ from typing import Deque, Dict, Tuple
 import rospy
 import tf2_ros
 from tf2_msgs.msg import TFMessage
+
+from mbot_slam_navigation.batched_reads import read_at_most_every
 
 _U32 = struct.Struct('<I')
 
@@ -49,9 +52,10 @@ def first_child_frame(raw: bytes) -> bytes:
 class LazyTransformBuffer(tf2_ros.Buffer):
     """A tf2_ros.Buffer and its listener in one; see the module's doc. `keep` [messages] per stream
     between two lookups; `subscribe` False leaves /tf and /tf_static to the caller (tests feed
-    on_tf)."""
+    on_tf); `read_period` [wall s]: /tf is read at most this often (0: as it comes)."""
 
-    def __init__(self, cache_time: rospy.Duration = None, keep: int = 3, subscribe: bool = True):
+    def __init__(self, cache_time: rospy.Duration = None, keep: int = 3, subscribe: bool = True,
+                 read_period: float = 0.0):
         super().__init__(cache_time, debug=subscribe)  # debug: the ~tf2_frames service, as Buffer() has
         self.keep = max(1, int(keep))
         self._lock = threading.Lock()
@@ -63,6 +67,8 @@ class LazyTransformBuffer(tf2_ros.Buffer):
         if subscribe:
             self._subs = [rospy.Subscriber('/tf', rospy.AnyMsg, self.on_tf, queue_size=None),
                           rospy.Subscriber('/tf_static', TFMessage, self.on_tf_static, queue_size=None)]
+            if read_period > 0.0:
+                read_at_most_every(self._subs[0], read_period)
 
     def unregister(self) -> None:
         for s in self._subs:
