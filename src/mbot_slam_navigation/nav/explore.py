@@ -45,7 +45,7 @@ escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals
 of one place before its frontier is given up; with the blacklist, this bounds every run),
 startup_timeout (300 s of wall time for move_base, the map, the costmap and the robot pose; then
 the report says not_started and why), model_name ('': the simulator's contacts of every robot count;
-a team sets each robot's own), read_period (0.01 s of wall time: /clock and /tf are read at most
+a team sets each robot's own), read_period (0.02 s of wall time: /clock and /tf are read at most
 this often, in batches, see batched_reads; the time and the pose then lag by up to that; 0: every
 message as it comes).
 
@@ -162,7 +162,7 @@ class Explore:
         self.shutdown_when_done = r.boolean('shutdown_when_done', False)
         self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
         self.startup_timeout = r.number('startup_timeout', 300.0, positive=True)
-        read_period = r.number('read_period', 0.01, minimum=0.0)
+        read_period = r.number('read_period', 0.02, minimum=0.0)
         self.return_timeout = r.number('return_timeout', 120.0, positive=True)
         self.escape_distance = r.number('escape_distance', 0.6, positive=True)
         self.escape_speed = r.number('escape_speed', 0.1, positive=True)
