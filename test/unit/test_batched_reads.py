@@ -1,11 +1,8 @@
 """batched_reads with a real master: a subscription read at most every `period` wakes about once
 a period and loses nothing; one without a period in the same process is untouched; rospy's time
 read that way keeps up with /clock and ends at its last value."""
-import os
-import socket
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -62,21 +59,10 @@ print('last', times[-1].to_nsec(), flush=True)
 '''
 
 
-def test_a_batched_subscription_wakes_once_a_period_and_keeps_every_message(tmp_path):
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        port = s.getsockname()[1]
-    env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % port, ROS_HOME=str(tmp_path))
-    master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, env=env)
+def test_a_batched_subscription_wakes_once_a_period_and_keeps_every_message(ros_master):
+    env = ros_master
     procs = []
     try:
-        for _ in range(100):
-            try:
-                rosgraph.Master('/probe', master_uri=env['ROS_MASTER_URI']).getPid()
-                break
-            except OSError:
-                time.sleep(0.1)
         master_api = rosgraph.Master('/probe', master_uri=env['ROS_MASTER_URI'])
         master_api.setParam('/use_sim_time', True)
         procs.append(subprocess.Popen([sys.executable, '-c', PUBLISHER], env=env, stdout=subprocess.DEVNULL,
@@ -96,6 +82,6 @@ def test_a_batched_subscription_wakes_once_a_period_and_keeps_every_message(tmp_
         assert lines['back'] == '0', out  # time never went back
         assert int(lines['last']) == 101999000000, out  # and ended at the last /clock message
     finally:
-        for p in procs + [master]:
+        for p in procs:
             p.terminate()
             p.wait()

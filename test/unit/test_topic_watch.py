@@ -1,6 +1,5 @@
 """topic_watch.WatchedSubscriber: a subscription with fewer connections than the master lists
 publishers, at two checks in a row, is made again; otherwise it is left alone."""
-import os
 
 import pytest
 
@@ -90,26 +89,13 @@ print('again', checks, len(got), got, w.sub.get_num_connections(), flush=True)
 '''
 
 
-def test_with_a_real_master_a_lost_latched_connection_comes_back(tmp_path):
-    import socket
+def test_with_a_real_master_a_lost_latched_connection_comes_back(ros_master):
     import subprocess
     import sys
     import time
-    rosgraph = pytest.importorskip('rosgraph.masterapi')
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        port = s.getsockname()[1]
-    env = dict(os.environ, ROS_MASTER_URI='http://localhost:%d' % port, ROS_HOME=str(tmp_path))
-    master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, env=env)
+    env = ros_master
     procs = []
     try:
-        for _ in range(100):
-            try:
-                rosgraph.Master('/probe', master_uri=env['ROS_MASTER_URI']).getPid()
-                break
-            except OSError:
-                time.sleep(0.1)
         procs.append(subprocess.Popen([sys.executable, '-c', PUBLISHER], env=env, stdout=subprocess.DEVNULL,
                                       stderr=subprocess.DEVNULL))
         time.sleep(1.0)
@@ -120,7 +106,7 @@ def test_with_a_real_master_a_lost_latched_connection_comes_back(tmp_path):
         assert lines.get('lost') == '0', out
         assert lines.get('again') == '[False, True] 2 [True, True] 1', out  # subscribed again, latched True again
     finally:
-        for p in procs + [master]:
+        for p in procs:
             p.terminate()
             p.wait()
 

@@ -78,7 +78,9 @@ from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
 
 from mbot_slam_navigation import explore_report
+from mbot_slam_navigation.batched_reads import clock_at_most_every
 from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
+from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
@@ -88,8 +90,6 @@ from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp,
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
-from mbot_slam_navigation.batched_reads import clock_at_most_every
-from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.topic_watch import WatchedSubscriber
 from mbot_slam_navigation.transforms import quaternion_to_yaw
 
