@@ -372,17 +372,17 @@ class SlamGmappingNode {
     heartbeat_pub_.publish(beat);
   }
 
+  // Called in the scan callback, the only thread that replaces slam_. The graph builds its map
+  // under its own locks (graph_slam.h), so the node's lock is not held meanwhile: the map -> odom
+  // broadcast, which takes it, goes on through a rebuild after an optimization (up to 0.45 s on a
+  // recorded run of the 30 x 20 m simulated floor, during which it stood still before). The
+  // particle filter's map is read under the lock. Built in a thread of its own instead, the map
+  // cost the node 4% more CPU on ACES (two runs each way) for little more.
   void publishMap(const ros::Time& stamp) {
+    if (!slam_) return;
     // Published as a shared message: one serialization for every subscriber, and dynamic_map
     // answers from the same message without another copy of megabytes.
-    // Called in the scan callback, the only thread that replaces slam_. The graph builds its map
-    // under its own locks (graph_slam.h), so the node's lock is not held meanwhile: the map ->
-    // odom broadcast, which takes it, goes on through a rebuild after an optimization (up to
-    // 0.45 s on a recorded run of the 30 x 20 m simulated floor, during which it stood still
-    // before). The particle filter's map is read under the lock. Built in a thread of its own
-    // instead, the map cost the node 4% more CPU on ACES (two runs each way) for little more.
     auto map = boost::make_shared<nav_msgs::OccupancyGrid>();
-    if (!slam_) return;
     if (backend_ == "graph") {
       mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), *map);
     } else {

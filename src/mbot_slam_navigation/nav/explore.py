@@ -194,7 +194,8 @@ class Explore:
         # read in batches (batched_reads): each message woke a thread, at 6x real time 1,100 a
         # wall second for a pose and a time wanted a few times a second.
         self.tf = LazyTransformBuffer(read_period=read_period)
-        clock_at_most_every(read_period)
+        if read_period > 0.0:
+            clock_at_most_every(read_period)
         # numpy_msg: the grids arrive as numpy arrays, not as tuples of Python ints (a 53k-cell
         # grid: 0.01 ms instead of 2.4 ms here)
         # Started by the same roslaunch as SLAM and move_base: a connection rospy lost while both
