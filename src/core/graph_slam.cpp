@@ -78,7 +78,7 @@ GraphSlam::GraphSlam(const GraphSlamParams& params)
       map_({params.xmin, params.ymin}, {params.xmax, params.ymax}, params.delta) {
   search_window_ = params_.local_search_window;
   map_.trackWrites();
-  if (params_.background) {
+  if (params_.background && params_.closures) {
     worker_ = std::thread([this] { backgroundLoop(); });
 #ifdef __linux__
     pthread_setname_np(worker_.native_handle(), "slam_closures");  // for top -H and /proc
@@ -189,17 +189,22 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
       pose = composePose(nodes_.back().pose, z);
       edges_.push_back({index - 1, index, z, edgeInformation(1.0), false});
     }
-    const bool redundant = !first && redundantLocked(pose, scan.seesAllRound());
+    const bool redundant = params_.closures && !first && redundantLocked(pose, scan.seesAllRound());
     nodes_.push_back({pose, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), points, redundant});
     if (redundant) {
       redundant_.push_back(index);
       ++stats_.redundant_nodes;
     }
     if (params_.keep_scan_poses) scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});  // the node is this scan
-    pending_.push_back(index);
+    if (params_.closures) {
+      pending_.push_back(index);
+    } else {
+      submapped_upto_ = index;  // no submap or closure search will need it
+    }
     rebuildLocalMapLocked();
     trimLocked();
   }
+  if (!params_.closures) return true;
   if (params_.background) {
     work_cv_.notify_one();
   } else {
@@ -231,7 +236,11 @@ void GraphSlam::trimLocked() {
   const int done = std::min(local_first - 1, submapped_upto_);
   // Match points serve only the local map, the submap and the closure search: no node needs them
   // after (the map is registered from the scans).
-  while (released_upto_ < done) nodes_[++released_upto_].points.reset();
+  while (released_upto_ < done) {
+    Node& n = nodes_[++released_upto_];
+    n.points.reset();
+    if (!params_.closures) n.scan.reset();  // tracking only: no map will be drawn from it
+  }
   while (!redundant_.empty() && redundant_.front() <= done) {
     const int k = redundant_.front();
     if (!params_.keep_trimmed_scans) nodes_[k].scan.reset();

@@ -25,15 +25,42 @@ void RbpfParams::validate() const {
   if (lasamplerange > 0.0 && !(lasamplestep > 0.0)) throw std::invalid_argument("lasamplestep must be positive");
   motion.validate();
   matcher.validate();
+  if (scan_odometry) tracking.validate();
 }
+
+namespace {
+
+// The track's parameters: the user's local SLAM values, the filter's map, no closures.
+GraphSlamParams trackingParams(const RbpfParams& p) {
+  GraphSlamParams g = p.tracking;
+  g.matcher = p.matcher;
+  g.delta = p.delta;
+  g.xmin = p.xmin;
+  g.ymin = p.ymin;
+  g.xmax = p.xmax;
+  g.ymax = p.ymax;
+  g.closures = false;
+  g.background = false;
+  g.keep_scan_poses = false;
+  return g;
+}
+
+}  // namespace
 
 RbpfSlam::RbpfSlam(const RbpfParams& params)
     : params_(params), motion_((params.validate(), params.motion)), matcher_(params.matcher, params.delta), rng_(params.seed) {
   const SlamGrid empty({params_.xmin, params_.ymin}, {params_.xmax, params_.ymax}, params_.delta);
   particles_.assign(params_.particles, Particle{Eigen::Vector3d::Zero(), 0.0, 0.0, empty, nullptr});
+  if (params_.scan_odometry) tracker_ = std::make_unique<GraphSlam>(trackingParams(params_));
 }
 
-bool RbpfSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
+bool RbpfSlam::processScan(const Eigen::Vector3d& wheel_odom, const LaserScan& scan, double time_s) {
+  Eigen::Vector3d odom = wheel_odom;
+  if (tracker_) {
+    // The track starts where odometry is at the first scan, as the map frame does.
+    tracker_->processScan(wheel_odom, scan, time_s);
+    odom = tracker_->currentPose();
+  }
   if (!initialized_) {
     // The map frame starts where odometry is at the first scan, so map and odom coincide there.
     for (Particle& p : particles_) p.pose = odom;
@@ -57,8 +84,9 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, d
   }
   for (Particle& p : particles_) {
     matcher_.registerScan(p.map, p.pose, scan);
-    p.node = std::make_shared<const TrajectoryNode>(TrajectoryNode{p.pose, odom, time_s, p.node});
+    p.node = std::make_shared<const TrajectoryNode>(TrajectoryNode{p.pose, wheel_odom, time_s, p.node});
   }
+  update_odom_ = odom;
   initialized_ = true;
   linear_distance_ = angular_distance_ = 0.0;
   last_update_time_ = time_s;
@@ -73,18 +101,18 @@ void RbpfSlam::drawFromProposal(Particle& p, const PreparedScan& scan) {
 
   // Improved proposal: likelihood on a small grid around the (matched) pose; the gaussian they
   // define is the proposal, their sum (the normalizer) the weight update.
-  std::vector<Eigen::Vector3d> samples;
+  std::vector<Eigen::Vector3d> offsets;  // from the matched pose; a sample is p.pose moved by one
   std::vector<double> logl;
   const int nl = params_.llsamplerange > 0.0 ? static_cast<int>(std::round(params_.llsamplerange / params_.llsamplestep)) : 0;
   const int na = params_.lasamplerange > 0.0 ? static_cast<int>(std::round(params_.lasamplerange / params_.lasamplestep)) : 0;
   for (int ix = -nl; ix <= nl; ++ix) {
     for (int iy = -nl; iy <= nl; ++iy) {
       for (int ia = -na; ia <= na; ++ia) {
-        const Eigen::Vector3d q(p.pose.x() + ix * params_.llsamplestep, p.pose.y() + iy * params_.llsamplestep,
-                                normalizeAngle(p.pose.z() + ia * params_.lasamplestep));
+        const Eigen::Vector3d offset(ix * params_.llsamplestep, iy * params_.llsamplestep, ia * params_.lasamplestep);
+        const Eigen::Vector3d q(p.pose.x() + offset.x(), p.pose.y() + offset.y(), normalizeAngle(p.pose.z() + offset.z()));
         double s, l;
         matcher_.likelihoodAndScore(p.map, q, scan, &s, &l);
-        samples.push_back(q);
+        offsets.push_back(offset);
         logl.push_back(l);
       }
     }
@@ -96,7 +124,9 @@ void RbpfSlam::drawFromProposal(Particle& p, const PreparedScan& scan) {
   for (std::size_t i = 0; i < logl.size(); ++i) {
     w[i] = std::exp(logl[i] - lmax);
     sum += w[i];
-    mean += w[i] * (samples[i] - p.pose);  // offsets: no angle wrap-around in a window this small
+    // The offsets, not the samples less the pose: a heading near +-pi wraps in the samples, and
+    // their difference was 2 pi off (a particle turned round at every such update).
+    mean += w[i] * offsets[i];
   }
   mean /= sum;
   // The proposal's mean; not a random draw from it: with likelihoods this peaked the gaussian is
@@ -163,7 +193,7 @@ int RbpfSlam::bestIndex() const {
 Eigen::Vector3d RbpfSlam::currentPose() const {
   const Particle& b = best();
   if (!b.node) return b.pose;
-  return composePose(b.node->pose, relativePose(b.node->odom, last_odom_));
+  return composePose(b.node->pose, relativePose(update_odom_, last_odom_));
 }
 
 std::vector<TrajectoryNode> RbpfSlam::trajectory() const {

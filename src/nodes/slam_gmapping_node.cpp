@@ -1,6 +1,8 @@
 // slam_gmapping: the gmapping node's interface on this package's C++ SLAM backends: `~backend`
 // graph (default; core/graph_slam.h, pose graph with loop closure) or rbpf (core/rbpf_slam.h,
-// gmapping's particle filter).
+// gmapping's particle filter; with `~scan_odometry` true, the default, it moves with the graph's
+// scan-matched track instead of the wheels' odometry, and the graph's `local_*` values set the
+// track).
 //
 // Subscribes `scan` (with tf from its frame to ~base_frame and from ~base_frame to ~odom_frame);
 // publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy` (rbpf only: the
@@ -132,6 +134,7 @@ class SlamGmappingNode {
     int seed = 0;
     param("seed", seed);
     p.seed = static_cast<unsigned>(seed);
+    param("scan_odometry", p.scan_odometry);
     param("backend", backend_);
     if (backend_ != "graph" && backend_ != "rbpf") {
       throw std::invalid_argument("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got '" + backend_ + "'");
@@ -242,6 +245,7 @@ class SlamGmappingNode {
       try {
         std::lock_guard<std::mutex> lock(mutex_);
         if (backend_ == "rbpf") {
+          params.tracking = graph_params_;  // the track's local SLAM (scan_odometry)
           slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
         } else {
           auto graph = graph_params_;
@@ -254,7 +258,9 @@ class SlamGmappingNode {
         return;
       }
       ROS_INFO("slam_gmapping: starting a new map: %s backend%s, laser at (%.3f, %.3f, %.3f) in %s, maxUrange %.2f m, maxRange %.2f m",
-               backend_.c_str(), backend_ == "rbpf" ? (" with " + std::to_string(params.particles) + " particles").c_str() : "",
+               backend_.c_str(),
+               backend_ == "rbpf" ? (" with " + std::to_string(params.particles) + " particles" +
+                                     (params.scan_odometry ? " on scan odometry" : " on wheel odometry")).c_str() : "",
                params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
                base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
     }
@@ -267,9 +273,10 @@ class SlamGmappingNode {
       // that then stands still (an explorer back at its start) would keep the map of before the
       // correction until it moved linearUpdate on, and its report would judge that map.
       outdated = !updated && slam_->mapOutdated();
-      // gmapping moves map -> odom at its updates only; the graph tracks every scan, and its
-      // optimizer moves the current pose by exactly its correction, so map -> odom follows both.
-      if (updated || backend_ == "graph") {
+      // gmapping moves map -> odom at its updates only; the graph (and the rbpf with
+      // scan_odometry) tracks every scan, and the graph's optimizer moves the current pose by
+      // exactly its correction, so map -> odom follows both.
+      if (updated || slam_->tracksEveryScan()) {
         before = map_to_odom_;
         after = map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
         moved = true;

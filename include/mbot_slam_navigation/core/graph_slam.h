@@ -212,6 +212,11 @@ struct GraphSlamParams {
   /// turns it off).
   bool keep_scan_poses = true;
   bool background = true;           ///< optimize in a background thread (false: inline, deterministic)
+  /// false: tracking only (the particle filter's scan odometry, rbpf_slam.h): every scan tracked
+  /// against the local map as above, but no submaps, no closure search, no optimization, and a
+  /// node's scan freed once it leaves the local map, so that memory stays flat; occupancy() then
+  /// draws the local map's nodes only. Not a ROS parameter.
+  bool closures = true;
   /// Throws std::invalid_argument naming the ROS parameter when a value is unusable.
   void validate() const;
 };
@@ -261,6 +266,7 @@ class GraphSlam : public SlamBackend {
   /// tenths of a second, and processScan does not wait for it).
   OccupancyImage occupancy(double occ_thresh) const override;
   bool mapOutdated() const override;  ///< does not wait for a rebuild in progress
+  bool tracksEveryScan() const override { return true; }
   int updates() const override;
 
   /// Waits until the background thread has searched every node for closures, then solves the

@@ -11,6 +11,12 @@
 //   3. weights are normalized (with ogain flattening them) and, when the effective sample size
 //      falls below resampleThreshold * particles, particles are resampled (low variance);
 //   4. the scan is registered into every particle's map.
+// With scan_odometry (the default), the filter's odometry is not the wheels' but the scan-matched
+// track of the pose graph's local SLAM (graph_slam.h with closures off: every scan matched against
+// a likelihood grid of the last nodes' scans): the particles then spread from a prediction a few
+// centimetres off, not the tens of centimetres of odometry that slips in a turn. On FR079 the
+// filter with wheel odometry is lost (1.9 m, as ROS's gmapping), with scan odometry it is not
+// (README, SLAM). Off, the filter is gmapping's.
 // Frames: odometry poses are base_footprint in odom; particle poses are base_footprint in map.
 #pragma once
 
@@ -20,6 +26,7 @@
 
 #include <Eigen/Core>
 
+#include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/motion_model.h"
 #include "mbot_slam_navigation/core/scan_matcher.h"
 #include "mbot_slam_navigation/core/slam_backend.h"
@@ -43,6 +50,11 @@ struct RbpfParams {
   unsigned seed = 0;
   MotionModelParams motion;
   ScanMatcherParams matcher;
+  /// `~scan_odometry`: the filter moves with the scan-matched track (above), not the wheels'.
+  bool scan_odometry = true;
+  /// The track's local SLAM (its `local_*` values, linearUpdate, angularUpdate); its matcher,
+  /// delta and map extent are the filter's, and closures are off whatever this says.
+  GraphSlamParams tracking;
   void validate() const;  ///< std::invalid_argument naming the gmapping parameter
 };
 
@@ -70,8 +82,11 @@ class RbpfSlam : public SlamBackend {
   int bestIndex() const;
   const Particle& best() const { return particles_[bestIndex()]; }
   const std::vector<Particle>& particles() const { return particles_; }
-  /// The best particle's pose composed with odometry since its last update: base in map now.
+  /// The best particle's pose composed with the filter's odometry (scan_odometry: the track)
+  /// since its last update: base in map now.
   Eigen::Vector3d currentPose() const override;
+  /// With scan_odometry the pose follows the track at every scan, not only at updates.
+  bool tracksEveryScan() const override { return tracker_ != nullptr; }
   /// The best particle's trajectory, oldest first.
   std::vector<TrajectoryNode> trajectory() const override;
   /// The best particle's map.
@@ -93,7 +108,10 @@ class RbpfSlam : public SlamBackend {
   std::mt19937 rng_;
   std::vector<Particle> particles_;
   bool initialized_ = false;
-  Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero();
+  std::unique_ptr<GraphSlam> tracker_;  // scan_odometry's track; null without
+  // The filter's odometry (the track, or the caller's) at the last scan and at the last update;
+  // the trajectory's nodes keep the caller's.
+  Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero(), update_odom_ = Eigen::Vector3d::Zero();
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0;
   double last_neff_ = 0.0;
   int updates_ = 0, resamples_ = 0;

@@ -41,6 +41,9 @@ class SlamBackend {
   /// graph's optimizer, in its own thread, after a loop closure): the map is worth publishing again
   /// even if the robot stands still.
   virtual bool mapOutdated() const { return false; }
+  /// True when currentPose() moves against odometry at every scan (scans are tracked), not only
+  /// at updates: the node then publishes map -> odom for every scan.
+  virtual bool tracksEveryScan() const { return false; }
   virtual int updates() const = 0;
 };
 

@@ -21,7 +21,7 @@ GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
     'sigma': 0.05, 'kernelSize': 1, 'lstep': 0.05, 'astep': 0.05, 'iterations': 5, 'lsigma': 0.075, 'ogain': 3.0,
     'lskip': 0, 'minimumScore': 0.0, 'srr': 0.1, 'srt': 0.2, 'str': 0.1, 'stt': 0.2, 'resampleThreshold': 0.5,
     'particles': 30, 'llsamplerange': 0.01, 'llsamplestep': 0.01, 'lasamplerange': 0.005, 'lasamplestep': 0.005,
-    'seed': 0,
+    'seed': 0, 'scan_odometry': 1,
 })
 # The pose graph's own (graph_slam.h; the node reads them under the same private names).
 GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
@@ -38,7 +38,7 @@ BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
 INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'local_map_nodes', 'submap_nodes',
               'loop_candidates'}
-BOOL_PARAMS = {'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
+BOOL_PARAMS = {'scan_odometry', 'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
 
 
 def defaults_of(backend: str) -> Dict[str, float]:
@@ -83,6 +83,11 @@ def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
     motion.srr, motion.srt, motion.str, motion.stt = v['srr'], v['srt'], v['str'], v['stt']
     p.motion = motion
     p.matcher = _matcher(v, laser_pose)
+    p.scan_odometry = bool(v['scan_odometry'])
+    # The track's local SLAM: the graph's defaults (a node every 0.5 m unless linearUpdate is
+    # given), as the node gives it.
+    shared = [k for k in COMMON_DEFAULTS if k == 'linearUpdate' and k in overrides or k != 'linearUpdate']
+    p.tracking = make_graph_params({k: v[k] for k in shared}, laser_pose)
     p.validate()
     return p
 
