@@ -28,17 +28,23 @@ void RbpfParams::validate() const {
   if (scan_odometry) tracking.validate();
 }
 
+void RbpfParams::shareWith(GraphSlamParams& g) const {
+  g.matcher = matcher;
+  g.angular_update = angular_update;
+  g.temporal_update = temporal_update;
+  g.delta = delta;
+  g.xmin = xmin;
+  g.ymin = ymin;
+  g.xmax = xmax;
+  g.ymax = ymax;
+}
+
 namespace {
 
 // The track's parameters: the user's local SLAM values, the filter's map, no closures.
 GraphSlamParams trackingParams(const RbpfParams& p) {
   GraphSlamParams g = p.tracking;
-  g.matcher = p.matcher;
-  g.delta = p.delta;
-  g.xmin = p.xmin;
-  g.ymin = p.ymin;
-  g.xmax = p.xmax;
-  g.ymax = p.ymax;
+  p.shareWith(g);
   g.closures = false;
   g.background = false;
   g.keep_scan_poses = false;

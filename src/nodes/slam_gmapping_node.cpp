@@ -171,16 +171,10 @@ class SlamGmappingNode {
     param("keep_trimmed_scans", g.keep_trimmed_scans);
     param("loop_solve_chi2", g.loop_solve_chi2);
     g.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
-    // The parameters both backends share have gmapping's names; read once above.
+    // The parameters both backends share have gmapping's names; read once above and given to the
+    // graph (or the rbpf's track) by RbpfParams::shareWith when the backend is made.
     // The graph's own default (graph_slam.h: a node every 0.5 m) unless the user set linearUpdate.
     if (pnh_.hasParam("linearUpdate")) g.linear_update = p.linear_update;
-    g.angular_update = p.angular_update;
-    g.temporal_update = p.temporal_update;
-    g.delta = p.delta;
-    g.xmin = p.xmin;
-    g.ymin = p.ymin;
-    g.xmax = p.xmax;
-    g.ymax = p.ymax;
     for (std::string* frame : {&base_frame_, &odom_frame_, &map_frame_}) {
       if (!frame->empty() && (*frame)[0] == '/') {
         ROS_WARN("slam_gmapping: frame '%s' has a leading '/', which tf2 rejects; using '%s'", frame->c_str(),
@@ -249,7 +243,7 @@ class SlamGmappingNode {
           slam_ = std::make_unique<mbot::core::RbpfSlam>(params);
         } else {
           auto graph = graph_params_;
-          graph.matcher = params.matcher;
+          params.shareWith(graph);
           slam_ = std::make_unique<mbot::core::GraphSlam>(graph);
         }
       } catch (const std::invalid_argument& e) {

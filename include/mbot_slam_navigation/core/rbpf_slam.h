@@ -56,6 +56,10 @@ struct RbpfParams {
   /// delta and map extent are the filter's, and closures are off whatever this says.
   GraphSlamParams tracking;
   void validate() const;  ///< std::invalid_argument naming the gmapping parameter
+  /// Gives `g` what both backends share under gmapping's names: the matcher (laser pose and
+  /// ranges), angularUpdate, temporalUpdate, delta and the map's extent (not linearUpdate: the
+  /// graph has its own default).
+  void shareWith(GraphSlamParams& g) const;
 };
 
 struct Particle {
