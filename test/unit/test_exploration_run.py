@@ -15,8 +15,11 @@ FAKE_ROSLAUNCH = r'''#!/usr/bin/env python3
 import json, os, signal, subprocess, sys, time
 args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
 life = 1 if args.get('mode') == 'explorer_dies' else 60
-node = subprocess.Popen([sys.executable, '-c', 'import time\nt=time.time()\nwhile time.time()-t<0.3: pass\ntime.sleep(%d)' % life,
-                         '__name:=explore'])
+# The "node" spins for 0.3 s of its own CPU time (not of wall time: on a loaded machine that gave
+# it as little as 0.14 s) and says so in a file, then idles.
+spun = os.path.join(args['report_dir'], 'spun')
+node = subprocess.Popen([sys.executable, '-c', 'import time\nt=time.process_time()\nwhile time.process_time()-t<0.3: pass\n'
+                         'open(%r, "w").close()\ntime.sleep(%d)' % (spun, life), '__name:=explore'])
 def bye(*_):
     node.terminate(); node.wait()
     open(os.path.join(args['report_dir'], 'stopped'), 'w').write('SIGINT')
@@ -25,6 +28,9 @@ signal.signal(signal.SIGINT, bye)
 if args.get('mode') == 'die':
     sys.exit(3)
 time.sleep(1.0)
+deadline = time.time() + 20.0  # the report comes after the node's spin, as a real explorer's after its work
+while not os.path.exists(spun) and time.time() < deadline:
+    time.sleep(0.05)
 if args.get('mode') not in ('hang', 'explorer_dies'):
     tmp = os.path.join(args['report_dir'], '.r.tmp')
     json.dump({'outcome': args.get('outcome', 'complete'), 'exploration_time_s': 12.0, 'wall_time_s': 1.0,

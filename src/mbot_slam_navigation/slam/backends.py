@@ -86,8 +86,7 @@ def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
     p.scan_odometry = bool(v['scan_odometry'])
     # The track's local SLAM: the graph's defaults (a node every 0.5 m unless linearUpdate is
     # given), as the node gives it.
-    shared = [k for k in COMMON_DEFAULTS if k == 'linearUpdate' and k in overrides or k != 'linearUpdate']
-    p.tracking = make_graph_params({k: v[k] for k in shared}, laser_pose)
+    p.tracking = make_graph_params({k: v[k] for k in COMMON_DEFAULTS if k != 'linearUpdate' or k in overrides}, laser_pose)
     p.validate()
     return p
 
