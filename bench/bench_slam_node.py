@@ -65,8 +65,10 @@ def cpu_of(stat_path):
 def node_cpu(pid):
     """(CPU seconds of a live process, every thread; {thread name: CPU seconds}) from /proc.
     The node names its threads: slam_gmapping (the callbacks: tracking, map publication; also roscpp's own threads),
-    slam_closures (the graph's loop closure and optimizer), slam_tf (the map -> odom broadcast);
-    the rest are roscpp's and tf2's."""
+    slam_closures (the graph's loop closure and optimizer), slam_tf (the map -> odom broadcast),
+    slam_particles (the rbpf's matching helpers: they live for one update, so they are missing
+    from the per-thread figures, but their CPU is in the process's total); the rest are roscpp's
+    and tf2's."""
     threads = {}
     for tid in os.listdir('/proc/%d/task' % pid):
         try:

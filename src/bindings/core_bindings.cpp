@@ -355,6 +355,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("motion", &RbpfParams::motion)
       .def_readwrite("matcher", &RbpfParams::matcher)
       .def_readwrite("scan_odometry", &RbpfParams::scan_odometry)
+      .def_readwrite("threads", &RbpfParams::threads)
       .def_readwrite("tracking", &RbpfParams::tracking)
       .def("validate", &RbpfParams::validate);
   // Both backends share the SlamBackend methods, bound once on the base class.

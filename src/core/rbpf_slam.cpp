@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 #include <string>
 
 #include <Eigen/Dense>
+#include <pthread.h>
 
 #include "mbot_slam_navigation/core/pose2d.h"
 
@@ -13,6 +15,7 @@ namespace mbot {
 namespace core {
 
 void RbpfParams::validate() const {
+  if (threads < 1) throw std::invalid_argument("threads must be >= 1, got " + std::to_string(threads));
   if (particles < 1) throw std::invalid_argument("particles must be >= 1, got " + std::to_string(particles));
   if (!(linear_update >= 0.0)) throw std::invalid_argument("linearUpdate must be >= 0");
   if (!(angular_update >= 0.0)) throw std::invalid_argument("angularUpdate must be >= 0");
@@ -85,7 +88,22 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& wheel_odom, const LaserScan& s
 
   if (initialized_) {
     const PreparedScan prepared = matcher_.prepare(scan);
-    for (Particle& p : particles_) drawFromProposal(p, prepared);
+    // Particle k is matched by thread k % threads; the calling thread takes share 0. std::async
+    // (not a pool that waits spinning) so that an idle filter costs nothing, and a thread's
+    // exception reaches the caller through get().
+    const int n = std::min<int>(params_.threads, static_cast<int>(particles_.size()));
+    auto share = [this, n, &prepared](int k) {
+      for (std::size_t i = k; i < particles_.size(); i += n) drawFromProposal(particles_[i], prepared);
+    };
+    std::vector<std::future<void>> helpers;
+    for (int k = 1; k < n; ++k) {
+      helpers.push_back(std::async(std::launch::async, [&share, k] {
+        pthread_setname_np(pthread_self(), "slam_particles");  // for top -H and /proc
+        share(k);
+      }));
+    }
+    share(0);
+    for (auto& h : helpers) h.get();
     normalizeAndResample();
   }
   for (Particle& p : particles_) {
@@ -100,7 +118,7 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& wheel_odom, const LaserScan& s
   return true;
 }
 
-void RbpfSlam::drawFromProposal(Particle& p, const PreparedScan& scan) {
+void RbpfSlam::drawFromProposal(Particle& p, const PreparedScan& scan) const {
   double score = 0.0;
   const Eigen::Vector3d matched = matcher_.optimize(p.map, p.pose, scan, &score);
   if (score > params_.minimum_score) p.pose = matched;

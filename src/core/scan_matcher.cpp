@@ -66,18 +66,35 @@ void ScanMatcher::likelihoodAndScore(const SlamGrid& map, const Eigen::Vector3d&
     const Cell ifree = map.worldToCell(pfree);
     const int fdx = ifree.x - ihit.x, fdy = ifree.y - ihit.y;
     double best = std::numeric_limits<double>::infinity();
-    for (int dx = -k; dx <= k; ++dx) {
-      for (int dy = -k; dy <= k; ++dy) {
-        const Cell cc{ihit.x + dx, ihit.y + dy};
-        const HitCell& cell = map.cell(cc);
-        // hits > threshold * visits, i.e. occupancy above the threshold, without a division
-        if (cell.visits == 0 || cell.hits <= params_.fullness_threshold * cell.visits) continue;
-        const HitCell& fcell = map.cell({cc.x + fdx, cc.y + fdy});
-        if (fcell.visits > 0 && fcell.hits >= params_.fullness_threshold * fcell.visits) continue;
-        const double inv = 1.0 / cell.hits;
-        const double mx = origin.x() + (cc.x + 0.5) * res + cell.acc_x * inv;
-        const double my = origin.y() + (cc.y + 0.5) * res + cell.acc_y * inv;
-        best = std::min(best, (phit.x() - mx) * (phit.x() - mx) + (phit.y() - my) * (phit.y() - my));
+    // A candidate: occupied, and the cell one step back along the beam is not.
+    auto consider = [&](const HitCell& cell, const Cell& cc) {
+      // hits > threshold * visits, i.e. occupancy above the threshold, without a division
+      if (cell.visits == 0 || cell.hits <= params_.fullness_threshold * cell.visits) return;
+      const HitCell& fcell = map.cell({cc.x + fdx, cc.y + fdy});
+      if (fcell.visits > 0 && fcell.hits >= params_.fullness_threshold * fcell.visits) return;
+      const double inv = 1.0 / cell.hits;
+      const double mx = origin.x() + (cc.x + 0.5) * res + cell.acc_x * inv;
+      const double my = origin.y() + (cc.y + 0.5) * res + cell.acc_y * inv;
+      best = std::min(best, (phit.x() - mx) * (phit.x() - mx) + (phit.y() - my) * (phit.y() - my));
+    };
+    const int lx = ihit.x & (SlamGrid::kPatchSize - 1), ly = ihit.y & (SlamGrid::kPatchSize - 1);
+    if (ihit.x >= 0 && ihit.y >= 0 && lx >= k && ly >= k && lx + k < SlamGrid::kPatchSize && ly + k < SlamGrid::kPatchSize) {
+      // The window lies in one patch (most beams): read it from there, and skip the beam at once
+      // when that patch was never written. This loop is most of the particle filter's time.
+      const HitCell* cells = map.patchCells(ihit.x >> SlamGrid::kPatchBits, ihit.y >> SlamGrid::kPatchBits);
+      if (cells) {
+        for (int dy = -k; dy <= k; ++dy) {  // rows outermost: a row's cells lie side by side
+          for (int dx = -k; dx <= k; ++dx) {
+            consider(cells[((ly + dy) << SlamGrid::kPatchBits) | (lx + dx)], Cell{ihit.x + dx, ihit.y + dy});
+          }
+        }
+      }
+    } else {
+      for (int dx = -k; dx <= k; ++dx) {
+        for (int dy = -k; dy <= k; ++dy) {
+          const Cell cc{ihit.x + dx, ihit.y + dy};
+          consider(map.cell(cc), cc);
+        }
       }
     }
     if (std::isfinite(best)) {

@@ -1,6 +1,7 @@
 // Pure conversions between ROS messages and core types, shared by the roscpp nodes.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -29,6 +30,29 @@ void toRos(core::OccupancyImage&& image, nav_msgs::OccupancyGrid& out);  // take
 /// (NaN or inf in the beam geometry, range_max <= range_min, no beams, fewer or more beams than
 /// angle_min..angle_max announce, no usable range at all), for a warning naming the topic.
 std::string describeScanProblem(const sensor_msgs::LaserScan& msg);
+
+/// Counts the messages a subscriber missed, from their header.seq: roscpp drops the oldest message
+/// without a word when a subscriber's queue is full, so a node that falls behind its scans would
+/// otherwise not know. seq 0 (publishers that leave it unset, bags written without it) and seq
+/// going backwards (a restarted publisher or bag) count nothing.
+class SeqGapCounter {
+ public:
+  /// Feeds one received message's seq; returns how many were missed just before it.
+  uint64_t feed(uint32_t seq) {
+    uint64_t missed = 0;
+    if (seen_ && seq > last_ + 1) missed = seq - last_ - 1;
+    seen_ = true;
+    last_ = seq;
+    total_ += missed;
+    return missed;
+  }
+  uint64_t total() const { return total_; }
+
+ private:
+  bool seen_ = false;
+  uint32_t last_ = 0;
+  uint64_t total_ = 0;
+};
 
 /// The candidate closest to `name` by edit distance (for "unknown parameter, did you mean" warnings).
 std::string nearestName(const std::string& name, const std::vector<std::string>& candidates);

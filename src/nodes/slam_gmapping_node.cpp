@@ -135,6 +135,7 @@ class SlamGmappingNode {
     param("seed", seed);
     p.seed = static_cast<unsigned>(seed);
     param("scan_odometry", p.scan_odometry);
+    param("threads", p.threads);
     param("backend", backend_);
     if (backend_ != "graph" && backend_ != "rbpf") {
       throw std::invalid_argument("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got '" + backend_ + "'");
@@ -195,6 +196,14 @@ class SlamGmappingNode {
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
+    if (scan_gaps_.feed(msg->header.seq) > 0) {
+      // The queue (5 scans, as gmapping's) overflowed: the node processes scans slower than they
+      // come, and the pose between updates is tracked over the gap.
+      ROS_WARN_THROTTLE(10.0, "slam_gmapping: %lu scans on %s dropped from the queue so far (by header.seq): the node "
+                        "processes scans slower than they arrive (a rosbag played too fast, a busy machine; "
+                        "~throttle_scans, or for the rbpf fewer ~particles, lightens the load)",
+                        static_cast<unsigned long>(scan_gaps_.total()), scan_sub_.getTopic().c_str());
+    }
     if (++scan_count_ % std::max(1, throttle_scans_) != 0) return;
     const std::string problem = mbot::ros_glue::describeScanProblem(*msg);
     if (!problem.empty()) {
@@ -478,6 +487,7 @@ class SlamGmappingNode {
   nav_msgs::OccupancyGrid::ConstPtr last_map_;  // as published; never changed after
   ros::Time last_stamp_, last_map_update_;
   long scan_count_ = 0;
+  mbot::ros_glue::SeqGapCounter scan_gaps_;  // scans roscpp dropped from the full queue
   static constexpr double kSummaryPeriod = 300.0;  // [s]
   ros::Time last_summary_;
   ros::Time last_trim_;  // when the heap was last trimmed (publishMap)

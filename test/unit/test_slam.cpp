@@ -387,10 +387,55 @@ TEST(RbpfSlam, HoldsThePoseWhenTheHeadingIsNearPi) {
   }
 }
 
+// The particles are matched on several threads (`threads`): each particle's update reads only its
+// own map, so the filter must come out the same, particle by particle, whatever their number.
+TEST(RbpfSlam, ThreadsDoNotChangeTheResult) {
+  const World2D room = syntheticRoom();
+  RbpfParams p;
+  p.particles = 7;  // not a multiple of the thread counts: uneven shares
+  p.matcher = matcherParams();
+  p.tracking.matcher = p.matcher;
+  p.linear_update = 0.2;
+  p.seed = 8;
+  std::vector<std::vector<Eigen::Vector3d>> poses;
+  std::vector<std::vector<double>> weights;
+  for (int threads : {1, 2, 3}) {
+    p.threads = threads;
+    RbpfSlam slam(p);
+    std::mt19937 rng(17);
+    Eigen::Vector3d truth(-2.5, 0.0, 0.0);
+    for (int i = 0; i < 120; ++i) {
+      truth = integrateArc(truth, 0.05, (i % 40 > 30) ? 0.1 : 0.0);
+      slam.processScan(truth, scanAt(room, truth, rng, 0.01), i * 0.1);
+    }
+    ASSERT_GT(slam.updates(), 20);
+    poses.emplace_back();
+    weights.emplace_back();
+    for (const Particle& q : slam.particles()) {
+      poses.back().push_back(q.pose);
+      weights.back().push_back(q.weight_sum);
+    }
+  }
+  for (std::size_t t = 1; t < poses.size(); ++t) {
+    for (std::size_t i = 0; i < poses[0].size(); ++i) {
+      EXPECT_EQ(poses[t][i], poses[0][i]) << "particle " << i << ", " << t + 1 << " threads";
+      EXPECT_EQ(weights[t][i], weights[0][i]) << "particle " << i << ", " << t + 1 << " threads";
+    }
+  }
+}
+
 TEST(RbpfSlam, RejectsBadParametersByName) {
   RbpfParams p;
   p.particles = 0;
   EXPECT_THROW(RbpfSlam{p}, std::invalid_argument);
+  p = RbpfParams();
+  p.threads = 0;
+  try {
+    RbpfSlam s(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("threads"), std::string::npos);
+  }
   p = RbpfParams();
   p.motion.srr = -1;
   try {

@@ -67,6 +67,14 @@ class SlamGrid {
     if (!p) return empty_cell_;
     return p->cells[((c.y & (kPatchSize - 1)) << kPatchBits) | (c.x & (kPatchSize - 1))];
   }
+  /// The cells of patch (px, py), row-major (kPatchSize per row), or nullptr when the patch lies
+  /// outside the grid or was never written (all its cells are empty): the scan matcher reads a
+  /// beam's whole window from one patch through it.
+  const HitCell* patchCells(int px, int py) const {
+    if (px < 0 || py < 0 || px >= patches_x_ || py >= patches_y_) return nullptr;
+    const Patch* p = patches_[static_cast<std::size_t>(py) * patches_x_ + px].get();
+    return p ? p->cells : nullptr;
+  }
   /// Mean hit point of a cell [m, world]; its centre when it has no hits.
   Eigen::Vector2d hitMean(const Cell& c) const;
 

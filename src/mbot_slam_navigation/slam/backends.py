@@ -21,7 +21,7 @@ GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
     'sigma': 0.05, 'kernelSize': 1, 'lstep': 0.05, 'astep': 0.05, 'iterations': 5, 'lsigma': 0.075, 'ogain': 3.0,
     'lskip': 0, 'minimumScore': 0.0, 'srr': 0.1, 'srt': 0.2, 'str': 0.1, 'stt': 0.2, 'resampleThreshold': 0.5,
     'particles': 30, 'llsamplerange': 0.01, 'llsamplestep': 0.01, 'lasamplerange': 0.005, 'lasamplestep': 0.005,
-    'seed': 0, 'scan_odometry': 1,
+    'seed': 0, 'scan_odometry': 1, 'threads': 2,
 })
 # The pose graph's own (graph_slam.h; the node reads them under the same private names).
 GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
@@ -36,7 +36,7 @@ GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
 })
 BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
-INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'local_map_nodes', 'submap_nodes',
+INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'threads', 'local_map_nodes', 'submap_nodes',
               'loop_candidates'}
 BOOL_PARAMS = {'scan_odometry', 'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
 
@@ -78,7 +78,7 @@ def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
     p.llsamplerange, p.llsamplestep = v['llsamplerange'], v['llsamplestep']
     p.lasamplerange, p.lasamplestep = v['lasamplerange'], v['lasamplestep']
     p.xmin, p.ymin, p.xmax, p.ymax = v['xmin'], v['ymin'], v['xmax'], v['ymax']
-    p.seed = int(v['seed'])
+    p.seed, p.threads = int(v['seed']), int(v['threads'])
     motion = _core._MotionModelParams()
     motion.srr, motion.srt, motion.str, motion.stt = v['srr'], v['srt'], v['str'], v['stt']
     p.motion = motion

@@ -35,13 +35,15 @@ def write_scan_bag(scans, path: str, range_max: float = 80.0, odom_frame: str = 
     from tf2_msgs.msg import TFMessage
     tmp = path + '.part'
     with rosbag.Bag(tmp, 'w') as bag:
-        for s in scans:
+        for seq, s in enumerate(scans):
             stamp = rospy.Time.from_sec(s.time)
             tf = TFMessage(transforms=[_transform(stamp, odom_frame, base_frame, s.odom),
                                        _transform(stamp, base_frame, laser_frame, s.laser_pose)])
             bag.write('/tf', tf, stamp)
             msg = LaserScan()
-            msg.header.stamp, msg.header.frame_id = stamp, laser_frame
+            # numbered as a driver's publisher numbers them: slam_gmapping counts the gaps (scans
+            # its full queue dropped) by header.seq
+            msg.header.seq, msg.header.stamp, msg.header.frame_id = seq, stamp, laser_frame
             msg.angle_min, msg.angle_increment = s.angle_min, s.angle_increment
             msg.angle_max = s.angle_min + s.angle_increment * (len(s.ranges) - 1)
             msg.range_min, msg.range_max = 0.0, range_max

@@ -21,6 +21,20 @@ TEST(RosConversions, ScanKeepsRep117Ranges) {
   EXPECT_NE(mbot::ros_glue::describeScanProblem(msg).find("no beams"), std::string::npos);
 }
 
+TEST(RosConversions, SeqGapCounterCountsMissedMessagesOnly) {
+  mbot::ros_glue::SeqGapCounter c;
+  EXPECT_EQ(c.feed(10), 0u);  // the first message: nothing known before it
+  EXPECT_EQ(c.feed(11), 0u);
+  EXPECT_EQ(c.feed(15), 3u);  // 12, 13 and 14 were dropped
+  EXPECT_EQ(c.feed(16), 0u);
+  EXPECT_EQ(c.feed(2), 0u);   // backwards: a restarted publisher, not a loss
+  EXPECT_EQ(c.feed(4), 1u);
+  EXPECT_EQ(c.total(), 4u);
+  mbot::ros_glue::SeqGapCounter unset;  // a publisher that leaves seq at 0
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(unset.feed(0), 0u);
+  EXPECT_EQ(unset.total(), 0u);
+}
+
 TEST(RosConversions, GridInfoAndData) {
   mbot::core::OccupancyGrid grid(4, 3, 0.5, {-1.0, 2.0});
   grid.setLogOdds({1, 2}, 5.0f);
