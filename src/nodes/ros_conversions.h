@@ -40,7 +40,7 @@ class SeqGapCounter {
   /// Feeds one received message's seq; returns how many were missed just before it.
   uint64_t feed(uint32_t seq) {
     uint64_t missed = 0;
-    if (seen_ && seq > last_ + 1) missed = seq - last_ - 1;
+    if (seen_ && uint64_t{seq} > uint64_t{last_} + 1) missed = uint64_t{seq} - last_ - 1;  // no wrap at 2^32 - 1
     seen_ = true;
     last_ = seq;
     total_ += missed;
