@@ -332,6 +332,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("max_urange", &ScanMatcherParams::max_urange)
       .def_readwrite("max_range", &ScanMatcherParams::max_range)
       .def_readwrite("laser_pose", &ScanMatcherParams::laser_pose);
+  m.def("scan_odometry_motion", &mbot::core::scanOdometryMotion,
+        "The motion noise the filter takes on scan odometry unless the user sets it (rbpf_slam.h).");
   using mbot::core::RbpfParams;
   py::class_<RbpfParams>(m, "_RbpfParams")
       .def(py::init<>())
@@ -356,6 +358,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("matcher", &RbpfParams::matcher)
       .def_readwrite("scan_odometry", &RbpfParams::scan_odometry)
       .def_readwrite("threads", &RbpfParams::threads)
+      .def_readwrite("best_switch_margin", &RbpfParams::best_switch_margin)
       .def_readwrite("tracking", &RbpfParams::tracking)
       .def("validate", &RbpfParams::validate);
   // Both backends share the SlamBackend methods, bound once on the base class.

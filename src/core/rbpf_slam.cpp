@@ -14,6 +14,15 @@
 namespace mbot {
 namespace core {
 
+MotionModelParams scanOdometryMotion() {
+  MotionModelParams m;
+  m.srr = 0.01;
+  m.srt = 0.02;
+  m.str = 0.01;
+  m.stt = 0.02;
+  return m;
+}
+
 void RbpfParams::validate() const {
   if (threads < 1) throw std::invalid_argument("threads must be >= 1, got " + std::to_string(threads));
   if (particles < 1) throw std::invalid_argument("particles must be >= 1, got " + std::to_string(particles));
@@ -28,6 +37,7 @@ void RbpfParams::validate() const {
   if (lasamplerange > 0.0 && !(lasamplestep > 0.0)) throw std::invalid_argument("lasamplestep must be positive");
   motion.validate();
   matcher.validate();
+  if (!(best_switch_margin >= 0.0)) throw std::invalid_argument("best_switch_margin must be >= 0");
   if (scan_odometry) tracking.validate();
 }
 
@@ -110,6 +120,7 @@ bool RbpfSlam::processScan(const Eigen::Vector3d& wheel_odom, const LaserScan& s
     matcher_.registerScan(p.map, p.pose, scan);
     p.node = std::make_shared<const TrajectoryNode>(TrajectoryNode{p.pose, wheel_odom, time_s, p.node});
   }
+  choosePublished();
   update_odom_ = odom;
   initialized_ = true;
   linear_distance_ = angular_distance_ = 0.0;
@@ -206,12 +217,23 @@ void RbpfSlam::normalizeAndResample() {
   ++resamples_;
 }
 
-int RbpfSlam::bestIndex() const {
-  int best = 0;
-  for (int i = 1; i < static_cast<int>(particles_.size()); ++i) {
-    if (particles_[i].weight_sum > particles_[best].weight_sum) best = i;
+void RbpfSlam::choosePublished() {
+  // Each particle's new node has as parent the node its particle had at the last update (a
+  // resampled copy: its ancestor's), so the children of the node published then are that
+  // lineage's particles.
+  int best = 0, lineage = -1;
+  for (int i = 0; i < static_cast<int>(particles_.size()); ++i) {
+    const Particle& p = particles_[i];
+    if (p.weight_sum > particles_[best].weight_sum) best = i;
+    if (published_ && p.node->parent == published_ && (lineage < 0 || p.weight_sum > particles_[lineage].weight_sum)) {
+      lineage = i;
+    }
   }
-  return best;
+  const double scale = params_.ogain * static_cast<double>(particles_.size());
+  const bool leave = lineage < 0 ||  // the lineage died out at the resampling
+                     (particles_[best].weight_sum - particles_[lineage].weight_sum) / scale > params_.best_switch_margin;
+  best_ = leave ? best : lineage;
+  published_ = particles_[best_].node;
 }
 
 Eigen::Vector3d RbpfSlam::currentPose() const {

@@ -113,6 +113,10 @@ class SlamGmappingNode {
     param("ogain", p.ogain);
     param("lskip", m.lskip);
     param("minimumScore", p.minimum_score);
+    // The motion noise defaults to the odometry the filter moves with: gmapping's for the wheels,
+    // a tenth of it for the scan-matched track (rbpf_slam.h).
+    param("scan_odometry", p.scan_odometry);
+    if (p.scan_odometry) p.motion = mbot::core::scanOdometryMotion();
     param("srr", p.motion.srr);
     param("srt", p.motion.srt);
     param("str", p.motion.str);
@@ -134,8 +138,8 @@ class SlamGmappingNode {
     int seed = 0;
     param("seed", seed);
     p.seed = static_cast<unsigned>(seed);
-    param("scan_odometry", p.scan_odometry);
     param("threads", p.threads);
+    param("best_switch_margin", p.best_switch_margin);
     param("backend", backend_);
     if (backend_ != "graph" && backend_ != "rbpf") {
       throw std::invalid_argument("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got '" + backend_ + "'");

@@ -349,12 +349,18 @@ TEST(RbpfSlam, ScanOdometryHoldsThePoseWhereTheWheelsSlip) {
   p.matcher = matcherParams();
   p.seed = 4;
   p.tracking.matcher = p.matcher;
-  double scan_mean, scan_max, wheel_mean, wheel_max;
+  double scan_mean, scan_max, wheel_mean, wheel_max, node_mean, node_max;
   driveLaps(room, p, 0.5, 1.2, &scan_mean, &scan_max);
+  // As the node and slam_offline run it: the track's own noise (a tenth of gmapping's).
+  RbpfParams q = p;
+  q.motion = scanOdometryMotion();
+  driveLaps(room, q, 0.5, 1.2, &node_mean, &node_max);
   p.scan_odometry = false;
   driveLaps(room, p, 0.5, 1.2, &wheel_mean, &wheel_max);
   EXPECT_LT(scan_mean, 0.04) << "wheels: " << wheel_mean;
   EXPECT_LT(scan_max, 0.15) << "wheels: " << wheel_max;
+  EXPECT_LT(node_mean, 0.04) << "wheels: " << wheel_mean;
+  EXPECT_LT(node_max, 0.15) << "wheels: " << wheel_max;
   EXPECT_GT(wheel_max, 0.3) << "scan odometry: " << scan_max;  // the case is one scan odometry is for
 }
 
@@ -424,6 +430,53 @@ TEST(RbpfSlam, ThreadsDoNotChangeTheResult) {
   }
 }
 
+// best_switch_margin: the particle published at an update descends from the one published at the
+// last update whenever a descendant survives and the best particle does not beat it by more than
+// the margin; 0 publishes the highest accumulated weight, as gmapping. On the wheels' odometry
+// (slipping, gmapping's noise) the best particle changes often; the margin keeps the lineage.
+TEST(RbpfSlam, ThePublishedParticleKeepsItsLineageWithinTheMargin) {
+  const World2D room = syntheticRoom();
+  const std::vector<double> turns = rectangleLaps(1);
+  int switches[2] = {0, 0};
+  for (int m = 0; m < 2; ++m) {
+    RbpfParams p;
+    p.particles = 10;
+    p.matcher = matcherParams();
+    p.scan_odometry = false;
+    p.linear_update = 0.3;
+    p.seed = 5;
+    p.best_switch_margin = m == 0 ? 0.0 : 4.0;
+    RbpfSlam slam(p);
+    std::mt19937 rng(17);
+    Eigen::Vector3d truth(-1.9, -1.2, 0.0), odom = truth;
+    std::shared_ptr<const TrajectoryNode> published;
+    const double scale = p.ogain * p.particles;
+    for (std::size_t i = 0; i < turns.size(); ++i) {
+      truth = integrateArc(truth, 0.05, turns[i]);
+      odom = integrateArc(odom, 0.05 * 0.8, turns[i] * 1.1);
+      if (!slam.processScan(odom, scanAt(room, truth, rng, 0.01), i * 0.1)) continue;
+      const auto& ps = slam.particles();
+      int top = 0, lineage = -1;
+      for (int k = 0; k < static_cast<int>(ps.size()); ++k) {
+        if (ps[k].weight_sum > ps[top].weight_sum) top = k;
+        if (published && ps[k].node->parent == published && (lineage < 0 || ps[k].weight_sum > ps[lineage].weight_sum)) lineage = k;
+      }
+      const Particle& chosen = slam.best();
+      if (lineage >= 0 && (ps[top].weight_sum - ps[lineage].weight_sum) / scale <= p.best_switch_margin) {
+        EXPECT_EQ(chosen.node->parent, published) << "left its lineage at scan " << i;
+        EXPECT_EQ(chosen.weight_sum, ps[lineage].weight_sum);
+      } else {
+        EXPECT_EQ(chosen.weight_sum, ps[top].weight_sum) << "did not take the best particle at scan " << i;
+      }
+      if (published && chosen.node->parent != published) ++switches[m];
+      published = chosen.node;
+    }
+    EXPECT_GT(slam.updates(), 20);
+  }
+  EXPECT_GT(switches[0], 3) << "the case needs changes of best particle";
+  EXPECT_LT(switches[1], switches[0]);
+}
+
 TEST(RbpfSlam, RejectsBadParametersByName) {
   RbpfParams p;
   p.particles = 0;
@@ -435,6 +488,14 @@ TEST(RbpfSlam, RejectsBadParametersByName) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("threads"), std::string::npos);
+  }
+  p = RbpfParams();
+  p.best_switch_margin = -1;
+  try {
+    RbpfSlam s(p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("best_switch_margin"), std::string::npos);
   }
   p = RbpfParams();
   p.motion.srr = -1;

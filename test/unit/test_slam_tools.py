@@ -180,6 +180,22 @@ def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
     assert make_graph_params({'keep_trimmed_scans': 1}).keep_trimmed_scans is True
 
 
+def test_the_filters_motion_noise_defaults_to_the_odometry_it_moves_with():
+    """gmapping's srr, srt, str, stt on the wheels; a tenth of them on the scan-matched track (the
+    default), unless the user gives them; what the user gives is kept whichever odometry."""
+    from mbot_slam_navigation.slam.backends import make_params
+
+    def noise(p):
+        return (p.motion.srr, p.motion.srt, p.motion.str, p.motion.stt)
+
+    assert noise(make_params({})) == pytest.approx((0.01, 0.02, 0.01, 0.02))
+    assert noise(make_params({'scan_odometry': 0})) == pytest.approx((0.1, 0.2, 0.1, 0.2))
+    assert noise(make_params({'srr': 0.05})) == pytest.approx((0.05, 0.02, 0.01, 0.02))
+    assert noise(make_params({'scan_odometry': 0, 'stt': 0.3})) == pytest.approx((0.1, 0.2, 0.1, 0.3))
+    with pytest.raises(ValueError, match='srt'):
+        make_params({'srt': -0.1})
+
+
 def test_the_graph_lists_its_chain_edges_as_the_relative_poses_of_its_nodes():
     from mbot_slam_navigation.slam.offline import run
     slam, _ = run(read_log(os.path.join(DATA, 'tiny.clf')), {'linearUpdate': 0.2, 'angularUpdate': 0.2},
@@ -201,6 +217,17 @@ def test_graph_defaults_in_python_are_the_cores():
     for key, value in GRAPH_DEFAULTS.items():
         if key not in COMMON_DEFAULTS:
             assert getattr(core, key) == pytest.approx(value), key
+
+
+def test_rbpf_defaults_in_python_are_the_cores():
+    # The same for the particle filter's own values that the core declares under the same name.
+    from mbot_slam_navigation import _core
+    from mbot_slam_navigation.slam.backends import GMAPPING_DEFAULTS
+    core = _core._RbpfParams()
+    for key in ('particles', 'ogain', 'llsamplerange', 'llsamplestep', 'lasamplerange', 'lasamplestep', 'seed',
+                'threads', 'best_switch_margin'):
+        assert getattr(core, key) == pytest.approx(GMAPPING_DEFAULTS[key]), key
+    assert core.scan_odometry == bool(GMAPPING_DEFAULTS['scan_odometry'])
 
 
 def test_a_carmen_log_becomes_a_bag_that_slam_can_play(tmp_path):

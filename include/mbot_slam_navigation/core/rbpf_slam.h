@@ -35,6 +35,14 @@
 namespace mbot {
 namespace core {
 
+/// The motion noise (srr, srt, str, stt) the node and `slam_offline` give the filter on scan odometry
+/// (`~scan_odometry`, the default) unless the user sets it: a tenth of gmapping's 0.1, 0.2, 0.1, 0.2,
+/// which are for wheels. The track drifts about a tenth as much; with gmapping's noise the particles
+/// spread far wider than its error, walk apart along the corridors and the published best particle
+/// changes between lineages a metre apart. Offline on ACES, seeds 0-7, as each scan was processed:
+/// median 0.068 m against 0.091 m with gmapping's noise, which lost the map in 2 of 8 (README, SLAM).
+MotionModelParams scanOdometryMotion();
+
 struct RbpfParams {
   int particles = 30;               ///< `particles`
   double linear_update = 1.0;       ///< [m] `linearUpdate`
@@ -48,7 +56,7 @@ struct RbpfParams {
   double delta = 0.05;              ///< [m] map resolution (`delta`)
   double xmin = -100, ymin = -100, xmax = 100, ymax = 100;  ///< [m] initial map extent (grows)
   unsigned seed = 0;
-  MotionModelParams motion;
+  MotionModelParams motion;         ///< gmapping's; the callers give scanOdometryMotion() with the track
   ScanMatcherParams matcher;
   /// `~scan_odometry`: the filter moves with the scan-matched track (above), not the wheels'.
   bool scan_odometry = true;
@@ -56,6 +64,14 @@ struct RbpfParams {
   /// result does not depend on it). Matching is three quarters of the filter's time, and a node
   /// on one thread did not keep up with FR079 played at 10x on a 2-core machine.
   int threads = 2;
+  /// `~best_switch_margin`: the particle the filter publishes (pose, map, trajectory) stays in the
+  /// lineage it published at the last update, the best of that particle's descendants, unless the
+  /// best particle's accumulated weight beats theirs by more than this, in the flattened units the
+  /// resampling weighs with (log-likelihood / (ogain * particles)): 4 is a weight 55 times theirs.
+  /// 0 is gmapping's choice, the highest accumulated weight at every update. A change of best
+  /// particle moves the published pose by the distance between the two lineages, often a metre
+  /// before a loop closes, and those jumps were much of the online error (README, SLAM).
+  double best_switch_margin = 4.0;
   /// The track's local SLAM (its `local_*` values, linearUpdate, angularUpdate); its matcher,
   /// delta and map extent are the filter's, and closures are off whatever this says.
   GraphSlamParams tracking;
@@ -87,8 +103,9 @@ class RbpfSlam : public SlamBackend {
   /// filter (motion since the last update exceeded the thresholds, or the first scan).
   bool processScan(const Eigen::Vector3d& odom_pose, const LaserScan& scan, double time_s) override;
 
-  int bestIndex() const;
-  const Particle& best() const { return particles_[bestIndex()]; }
+  /// The particle the filter publishes (`best_switch_margin`), chosen at each update.
+  int bestIndex() const { return best_; }
+  const Particle& best() const { return particles_[best_]; }
   const std::vector<Particle>& particles() const { return particles_; }
   /// The best particle's pose composed with the filter's odometry (scan_odometry: the track)
   /// since its last update: base in map now.
@@ -110,6 +127,8 @@ class RbpfSlam : public SlamBackend {
   /// Reads only its particle's map and the matcher: safe to run for several particles at once.
   void drawFromProposal(Particle& p, const PreparedScan& scan) const;
   void normalizeAndResample();
+  /// Chooses best_ among the particles just updated (their nodes new): see best_switch_margin.
+  void choosePublished();
 
   RbpfParams params_;
   MotionModel motion_;
@@ -123,6 +142,8 @@ class RbpfSlam : public SlamBackend {
   Eigen::Vector3d last_odom_ = Eigen::Vector3d::Zero(), update_odom_ = Eigen::Vector3d::Zero();
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0;
   double last_neff_ = 0.0;
+  int best_ = 0;
+  std::shared_ptr<const TrajectoryNode> published_;  // best_'s node at the last update
   int updates_ = 0, resamples_ = 0;
 };
 

@@ -16,12 +16,14 @@ COMMON_DEFAULTS = {
     'maxUrange': 80.0, 'maxRange': 80.0, 'linearUpdate': 1.0, 'angularUpdate': 0.5, 'temporalUpdate': -1.0,
     'xmin': -100.0, 'ymin': -100.0, 'xmax': 100.0, 'ymax': 100.0, 'delta': 0.05,
 }
-# The particle filter's own (gmapping's).
+# The particle filter's own (gmapping's). srr, srt, str and stt are these on the wheels' odometry
+# (scan_odometry 0); on the scan-matched track, unless given, a tenth of them
+# (_core.scan_odometry_motion(), rbpf_slam.h).
 GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
     'sigma': 0.05, 'kernelSize': 1, 'lstep': 0.05, 'astep': 0.05, 'iterations': 5, 'lsigma': 0.075, 'ogain': 3.0,
     'lskip': 0, 'minimumScore': 0.0, 'srr': 0.1, 'srt': 0.2, 'str': 0.1, 'stt': 0.2, 'resampleThreshold': 0.5,
     'particles': 30, 'llsamplerange': 0.01, 'llsamplestep': 0.01, 'lasamplerange': 0.005, 'lasamplestep': 0.005,
-    'seed': 0, 'scan_odometry': 1, 'threads': 2,
+    'seed': 0, 'scan_odometry': 1, 'threads': 2, 'best_switch_margin': 4.0,
 })
 # The pose graph's own (graph_slam.h; the node reads them under the same private names).
 GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
@@ -38,6 +40,7 @@ BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
 INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'threads', 'local_map_nodes', 'submap_nodes',
               'loop_candidates'}
+MOTION_PARAMS = ('srr', 'srt', 'str', 'stt')
 BOOL_PARAMS = {'scan_odometry', 'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
 
 
@@ -78,12 +81,14 @@ def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
     p.llsamplerange, p.llsamplestep = v['llsamplerange'], v['llsamplestep']
     p.lasamplerange, p.lasamplestep = v['lasamplerange'], v['lasamplestep']
     p.xmin, p.ymin, p.xmax, p.ymax = v['xmin'], v['ymin'], v['xmax'], v['ymax']
-    p.seed, p.threads = int(v['seed']), int(v['threads'])
-    motion = _core._MotionModelParams()
-    motion.srr, motion.srt, motion.str, motion.stt = v['srr'], v['srt'], v['str'], v['stt']
+    p.seed, p.threads, p.best_switch_margin = int(v['seed']), int(v['threads']), v['best_switch_margin']
+    p.scan_odometry = bool(v['scan_odometry'])
+    motion = _core.scan_odometry_motion() if p.scan_odometry else _core._MotionModelParams()
+    for key in MOTION_PARAMS:
+        if key in overrides or not p.scan_odometry:
+            setattr(motion, key, v[key])
     p.motion = motion
     p.matcher = _matcher(v, laser_pose)
-    p.scan_odometry = bool(v['scan_odometry'])
     # The track's local SLAM: the graph's defaults (a node every 0.5 m unless linearUpdate is
     # given), as the node gives it.
     p.tracking = make_graph_params({k: v[k] for k in COMMON_DEFAULTS if k != 'linearUpdate' or k in overrides}, laser_pose)
