@@ -481,28 +481,18 @@ TEST(RbpfSlam, RejectsBadParametersByName) {
   RbpfParams p;
   p.particles = 0;
   EXPECT_THROW(RbpfSlam{p}, std::invalid_argument);
-  p = RbpfParams();
-  p.threads = 0;
-  try {
-    RbpfSlam s(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("threads"), std::string::npos);
-  }
-  p = RbpfParams();
-  p.best_switch_margin = -1;
-  try {
-    RbpfSlam s(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("best_switch_margin"), std::string::npos);
-  }
-  p = RbpfParams();
-  p.motion.srr = -1;
-  try {
-    RbpfSlam s(p);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("srr"), std::string::npos);
-  }
+  // Each bad value alone, over the defaults: the message names the parameter.
+  auto expectNamed = [](void (*spoil)(RbpfParams&), const std::string& name) {
+    RbpfParams q;
+    spoil(q);
+    try {
+      RbpfSlam s(q);
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  };
+  expectNamed([](RbpfParams& q) { q.threads = 0; }, "threads");
+  expectNamed([](RbpfParams& q) { q.best_switch_margin = -1; }, "best_switch_margin");
+  expectNamed([](RbpfParams& q) { q.motion.srr = -1; }, "srr");
 }
