@@ -21,7 +21,8 @@ to the .log beside it.
 
 Environment: SLAM_NODE_LOGS (default aces,fr079), SLAM_BACKENDS (default graph,rbpf),
 SLAM_NODE_RATE (playback rate, default 10), SLAM_NODE_OFFLINE=0 to skip the offline runs,
-SLAM_NODE_PACED=0 to skip only the paced one (it takes as long as the play).
+SLAM_NODE_PACED=0 to skip only the paced one (it takes as long as the play), SLAM_NODE_ARGS for
+more of the node's parameters (`_scan_queue_size:=50`).
 Targets (issue 21): online translation error <= 0.05 m (graph), <= 0.068 m (rbpf, gmapping's ACES
 figure); node CPU <= 1.2x offline. Run inside the devel environment (make bench does that).
 """
@@ -165,8 +166,9 @@ def play(name, bag, scans, backend, rate, recorder, env):
     duration = scans[-1].time - scans[0].time
     recorder.reset(duration + 60.0)
     log = open(os.path.join(OUT, 'slam_node_%s_%s.log' % (name, backend)), 'w')
+    extra = os.environ.get('SLAM_NODE_ARGS', '').split()
     node = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=slam_gmapping',
-                             '_backend:=' + backend], env=env, stdout=log, stderr=subprocess.STDOUT)
+                             '_backend:=' + backend] + extra, env=env, stdout=log, stderr=subprocess.STDOUT)
     try:
         wait_for_subscriber('/scan', node, timeout_s=30.0)
         t0 = time.time()

@@ -81,13 +81,17 @@ class SlamHomeTest(unittest.TestCase):
         self.assertEqual((served.info.width, served.info.height), (msg.info.width, msg.info.height))
         self.assertEqual(served.header.frame_id, 'map')
 
-    def test_an_unknown_backend_stops_the_node_with_its_name(self):
-        out = subprocess.run(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=backend_check',
-                              '_backend:=particles', 'scan:=/backend_check/scan', 'map:=/backend_check/map',
-                              'dynamic_map:=/backend_check/dynamic_map'],
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
-        self.assertEqual(out.returncode, 1, out.stdout)
-        self.assertIn("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got 'particles'", out.stdout)
+    def test_a_bad_parameter_stops_the_node_with_its_name(self):
+        for arg, message in (('_backend:=particles',
+                              "~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got 'particles'"),
+                             ('_scan_queue_size:=0', '~scan_queue_size must be at least 1')):
+            with self.subTest(arg=arg):
+                out = subprocess.run(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=param_check', arg,
+                                      'scan:=/param_check/scan', 'map:=/param_check/map',
+                                      'dynamic_map:=/param_check/dynamic_map'],
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=60)
+                self.assertEqual(out.returncode, 1, out.stdout)
+                self.assertIn(message, out.stdout)
 
     def test_tutorial_typo_and_bad_scans_get_warnings(self):
         # A second instance, started as the tutorial does (~base_link, a typo for ~base_frame), in
