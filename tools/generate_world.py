@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Generates exploration worlds (Gazebo SDF) with their room tables, from a seed.
 
-    tools/generate_world.py KIND [--seed N] [--out DIR]     KIND: office, apartment, large, gap, boxed, all
+    tools/generate_world.py KIND [--seed N] [--out DIR]
+    KIND: office, apartment, large, corridor, ring, ring_rooms, hall, gap, boxed, all
 
 Each world is written as DIR/<name>.world with DIR/<name>.rooms.yaml beside it: the spawn pose
 (x, y, yaw; every world is moved so that its spawn point is the origin, as in the home) and the rooms (name, xmin, xmax, ymin, ymax) [m, world frame] that the exploration
@@ -13,10 +14,17 @@ door gaps are cut out of the centre lines. The same seed gives the same world.
 - apartment: a cluttered flat of 10 m x 8 m: rooms with furniture, narrow passages, and one door
   gap barely wider than the robot (0.55 m clear between the wall ends, for the mbot's 0.4 m).
 - large: a floor of 32 m x 22 m: four halls around a cross of corridors, pillars and crates.
+- corridor, ring, ring_rooms, hall: plain geometry, where a scan constrains some directions weakly
+  and places look alike (every size drawn from the seed):
+  - corridor: one plain corridor 40-50 m long and 2-3 m wide, closed at both ends;
+  - ring: a square ring of plain corridors, 18-22 m a side outside, 2.5-3.5 m wide;
+  - ring_rooms: four empty rooms filling the inside of such a ring (20-24 m a side), one door each;
+  - hall: an open hall 30-36 m x 30-36 m with 3-5 pillars, wider than the laser reaches across.
 - gap, boxed (test worlds, no seed): two rooms joined only by a 0.3 m gap, narrower than the
   robot; a robot boxed in by walls 0.15 m from it on every side.
 """
 import argparse
+import math
 import os
 import random
 import sys
@@ -193,6 +201,71 @@ def large(seed: int) -> Plan:
     return p
 
 
+def corridor(seed: int) -> Plan:
+    rng = random.Random(seed)
+    p = Plan('corridor')
+    length, width = rng.uniform(40.0, 50.0), rng.uniform(2.0, 3.0)
+    p.walls += [(0, 0, length, 0), (length, 0, length, width), (length, width, 0, width), (0, width, 0, 0)]
+    p.spawn = (1.5, round(width / 2, 3), 0.0)
+    p.room('corridor', 0.0, length, 0.0, width)
+    return p
+
+
+def ring_plan(name: str, rng: random.Random, side_range, width_range) -> Tuple[Plan, float, float]:
+    """A square ring of plain corridors: the outer square [0, side]^2, the inner block's walls
+    `width` inside it; the spawn point in the middle of the south corridor, facing east."""
+    p = Plan(name)
+    s, w = rng.uniform(*side_range), rng.uniform(*width_range)
+    p.walls += [(0, 0, s, 0), (s, 0, s, s), (s, s, 0, s), (0, s, 0, 0)]
+    p.room('south corridor', 0.0, s, 0.0, w)
+    p.room('north corridor', 0.0, s, s - w, s)
+    p.room('west corridor', 0.0, w, w, s - w)
+    p.room('east corridor', s - w, s, w, s - w)
+    p.spawn = (round(s / 2, 3), round(w / 2, 3), 0.0)
+    return p, s, w
+
+
+def ring(seed: int) -> Plan:
+    p, s, w = ring_plan('ring', random.Random(seed), (18.0, 22.0), (2.5, 3.5))
+    p.walls += [(w, w, s - w, w), (s - w, w, s - w, s - w), (s - w, s - w, w, s - w), (w, s - w, w, w)]
+    return p
+
+
+def ring_rooms(seed: int) -> Plan:
+    rng = random.Random(seed)
+    p, s, w = ring_plan('ring_rooms', rng, (20.0, 24.0), (2.5, 3.0))
+    a, b, m = w, s - w, s / 2  # the inner square [a, b]^2, four rooms split at m
+    door = lambda lo, hi: (lambda d: (d, d + 1.0))(rng.uniform(lo + 1.0, hi - 2.0))  # noqa: E731
+    # each room's door opens from the corridor along its outer side
+    p.walls += wall_with_doors(a, a, b, a, [door(a, m), door(m, b)])        # south rooms' south wall
+    p.walls += wall_with_doors(a, b, b, b, [door(a, m), door(m, b)])        # north rooms' north wall
+    p.walls += [(a, a, a, b), (b, a, b, b), (m, a, m, b), (a, m, b, m)]     # west, east, partitions
+    for name, x0, x1, y0, y1 in (('south-west room', a, m, a, m), ('south-east room', m, b, a, m),
+                                 ('north-west room', a, m, m, b), ('north-east room', m, b, m, b)):
+        p.room(name, x0, x1, y0, y1)
+    return p
+
+
+def hall(seed: int) -> Plan:
+    rng = random.Random(seed)
+    p = Plan('hall')
+    wx, wy = rng.uniform(30.0, 36.0), rng.uniform(30.0, 36.0)
+    p.walls += [(0, 0, wx, 0), (wx, 0, wx, wy), (wx, wy, 0, wy), (0, wy, 0, 0)]
+    p.spawn = (2.0, round(wy / 2, 3), 0.0)
+    p.room('hall', 0.0, wx, 0.0, wy)
+    pillars, count = [], rng.randint(3, 5)
+    while len(pillars) < count:
+        x, y = rng.uniform(4.0, wx - 4.0), rng.uniform(4.0, wy - 4.0)
+        if all(math.hypot(x - u, y - v) > 6.0 for u, v in pillars) and math.hypot(x - 2.0, y - wy / 2) > 4.0:
+            pillars.append((x, y))
+    for k, (x, y) in enumerate(pillars):
+        if k % 2 == 0:
+            p.cylinders.append(('pillar_%d' % k, x, y, 0.3))
+        else:
+            p.boxes.append(('pillar_%d' % k, x, y, 0.6, 0.6))
+    return p
+
+
 def gap() -> Plan:
     p = Plan('gap')
     p.spawn = (1.5, 1.5, 0.0)
@@ -215,7 +288,8 @@ def boxed() -> Plan:
     return p
 
 
-KINDS = {'office': office, 'apartment': apartment, 'large': large}
+KINDS = {'office': office, 'apartment': apartment, 'large': large, 'corridor': corridor, 'ring': ring,
+         'ring_rooms': ring_rooms, 'hall': hall}
 FIXED = {'gap': gap, 'boxed': boxed}
 
 

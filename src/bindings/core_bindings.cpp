@@ -485,6 +485,8 @@ PYBIND11_MODULE(_core, m) {
              d["nodes"] = st.nodes;
              d["local_match_failures"] = st.local_match_failures;
              d["innovation_rms"] = st.innovation_rms;
+             d["pinned_innovation_rms"] = st.pinned_innovation_rms;
+             d["match_weakest_m"] = st.match_weakest_m;
              d["prior_weight"] = st.prior_weight;
              d["search_window_m"] = st.search_window_m;
              d["loop_attempts"] = st.loop_attempts;

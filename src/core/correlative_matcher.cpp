@@ -7,6 +7,7 @@
 #include <string>
 #include <unordered_set>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "mbot_slam_navigation/core/cell.h"
@@ -448,6 +449,34 @@ Eigen::Vector3d refineMatch(const LikelihoodGrid& grid, const std::vector<Eigen:
   }
   if (score) *score = best_plain;
   return current;
+}
+
+Eigen::Matrix3d scoreCurvature(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                               const Eigen::Vector3d& pose) {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  if (points.empty()) return h;
+  double range = 0.0;
+  for (const auto& p : points) range += p.norm();
+  range /= static_cast<double>(points.size());
+  const double hl = 0.5 * grid.resolution();
+  const Eigen::Vector3d step(hl, hl, hl / std::max(range, grid.resolution()));
+  auto at = [&](const Eigen::Vector3d& d) { return grid.score(points, pose + d); };
+  const double s0 = at(Eigen::Vector3d::Zero());
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d di = Eigen::Vector3d::Zero();
+    di[i] = step[i];
+    h(i, i) = -(at(di) - 2.0 * s0 + at(-di)) / (step[i] * step[i]);
+    for (int j = i + 1; j < 3; ++j) {
+      Eigen::Vector3d dj = Eigen::Vector3d::Zero();
+      dj[j] = step[j];
+      h(i, j) = h(j, i) = -(at(di + dj) - at(di - dj) - at(dj - di) + at(-di - dj)) / (4.0 * step[i] * step[j]);
+    }
+  }
+  // A pose off the peak (a climb stopped on a slope) may give a saddle: what does not curve down
+  // constrains nothing.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h);
+  const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
 }
 
 }  // namespace core

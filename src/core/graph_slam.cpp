@@ -11,6 +11,7 @@
 #include <pthread.h>
 #endif
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>  // Matrix3d::inverse
 
 #include "mbot_slam_navigation/core/pose2d.h"
@@ -376,22 +377,47 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
   }
   // How far the scan moves odometry's prediction, over the last few hundred scans: small where
   // odometry is good (the simulator: 3 mm a scan), large where it slips (the Radish logs: 28-33 mm).
-  const double innovation2 = (refined.head<2>() - predicted.head<2>()).squaredNorm();
+  // Only in the directions the scan pins (its score curves down there as if at least
+  // kConstrainedShare of the returns lay on surfaces square to it): along a plain corridor the
+  // best match lies anywhere in the window, and that says nothing of odometry.
+  const Eigen::Matrix3d curvature = scoreCurvature(grid, points, refined);
+  const double sigma = localSigma();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> xy(curvature.topLeftCorner<2, 2>());
+  const Eigen::Vector2d e = refined.head<2>() - predicted.head<2>();
+  double pinned2 = 0.0;
+  int pinned = 0;
+  for (int k = 0; k < 2; ++k) {
+    if (xy.eigenvalues()[k] * sigma * sigma < kConstrainedShare) continue;
+    const double along = xy.eigenvectors().col(k).dot(e);
+    pinned2 += along * along;
+    ++pinned;
+  }
   double prior_weight = params_.local_prior_weight;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    stats_.match_weakest_m = 1.0 / std::sqrt(std::max(xy.eigenvalues().minCoeff() * params_.local_prior_points, 1e-12));
     // The plain mean until kInnovationWindow scans, then a running one over about that many (a
     // running mean from the first scan on would still be mostly that scan's at the warm-up's end).
-    innovation2_ += (innovation2 - innovation2_) / std::min<double>(innovations_ + 1, kInnovationWindow);
+    // The window must hold odometry's worst steps, wherever the scan looked: every direction.
+    const double all2 = e.squaredNorm();
+    innovation2_ += (all2 - innovation2_) / std::min<double>(innovations_ + 1, kInnovationWindow);
     ++innovations_;
-    if (params_.local_prior_points > 0.0 && innovations_ >= kInnovationWarmup) {
-      // Never below the configured weight: where the scan leaves a direction open (a corridor
-      // without features) the best match along it is any, and the innovation says nothing of odometry.
-      prior_weight = std::clamp(1.0 / (2.0 * params_.local_prior_points * std::max(innovation2_, 1e-8)),
+    // The prior's weight, from the pinned directions only (per direction, counted as the 2-d
+    // squared distance: twice it).
+    if (pinned > 0) {
+      const double pinned_mean2 = 2.0 * pinned2 / pinned;
+      pinned_innovation2_ +=
+          (pinned_mean2 - pinned_innovation2_) / std::min<double>(pinned_innovations_ + 1, kInnovationWindow);
+      ++pinned_innovations_;
+    }
+    if (params_.local_prior_points > 0.0 && pinned_innovations_ >= kInnovationWarmup) {
+      // Never below the configured weight.
+      prior_weight = std::clamp(1.0 / (2.0 * params_.local_prior_points * std::max(pinned_innovation2_, 1e-8)),
                                 params_.local_prior_weight, std::max(params_.local_prior_weight, kMaxPriorWeight));
     }
     stats_.prior_weight = prior_weight;
     stats_.innovation_rms = std::sqrt(innovation2_);
+    stats_.pinned_innovation_rms = std::sqrt(pinned_innovation2_);
     if (params_.local_search_sigmas > 0.0 && innovations_ >= kInnovationWarmup) {
       search_window_ = std::clamp(params_.local_search_sigmas * stats_.innovation_rms, params_.local_search_window,
                                   params_.local_search_max_window);
@@ -760,6 +786,11 @@ std::vector<std::pair<double, Eigen::Vector3d>> GraphSlam::scanPoses() const {
   out.reserve(scans_.size());
   for (const TrackedScan& t : scans_) out.emplace_back(t.time_s, composePose(nodes_[t.node].pose, t.offset));
   return out;
+}
+
+double GraphSlam::trackingWeakestSigma() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_.match_weakest_m;
 }
 
 int GraphSlam::updates() const {

@@ -1,8 +1,10 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include "mbot_slam_navigation/core/cell.h"
@@ -331,4 +333,34 @@ TEST(CorrelativeMatcher, VisibilityKnowsWhatAScanSawAndWhatLayBehindOrBeyond) {
   const auto kept = front.seenOf(points, {0.5, 0.0, 0.0}, 0.05);
   ASSERT_EQ(kept.size(), 2u);
   EXPECT_DOUBLE_EQ(kept[1].x(), 2.5);
+}
+
+TEST(CorrelativeMatcher, TheScoresCurvatureSaysWhichDirectionsAScanFixes) {
+  // In the room every direction is fixed; along a plain corridor 2 m wide the score does not curve
+  // along it (the scan cannot tell how far the robot went) while across it every return pins it.
+  std::mt19937 rng(4);
+  const double sigma = 0.075;
+  const Eigen::Vector3d pose(-1.0, 0.5, 0.3);
+  const auto room_points = matchPoints(scanAt(room(), pose, rng, 0.01), Eigen::Vector3d::Zero(), 11.0, 0.05);
+  const LikelihoodGrid room_grid(inWorld(room_points, pose), 0.05, sigma);
+  const Eigen::Matrix3d in_room = scoreCurvature(room_grid, room_points, pose);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> room_xy(in_room.topLeftCorner<2, 2>());
+  EXPECT_GT(room_xy.eigenvalues().minCoeff() * sigma * sigma, 0.1) << in_room;
+  EXPECT_GT(in_room(2, 2), 0.0);
+
+  World2D corridor;
+  corridor.addBox({0.0, 1.05}, 0, 60.0, 0.1);
+  corridor.addBox({0.0, -1.05}, 0, 60.0, 0.1);
+  // The reference as scan tracking builds its local map: walls as surfaces (surfacePoints), from
+  // a scan 0.5 m back; hits alone thin out along a wall and would pin the scan to their spacing.
+  const Eigen::Vector3d behind(-0.5, 0.2, 0.0), along(0.0, 0.2, 0.0);
+  const LikelihoodGrid grid(
+      inWorld(surfacePoints(scanAt(corridor, behind, rng, 0.01), Eigen::Vector3d::Zero(), 6.0, 0.05), behind), 0.05,
+      sigma);
+  const auto points = matchPoints(scanAt(corridor, along, rng, 0.01), Eigen::Vector3d::Zero(), 6.0, 0.05);
+  const Eigen::Matrix3d c = scoreCurvature(grid, points, along);
+  EXPECT_LT(c(0, 0) * sigma * sigma, 0.02) << c;  // along the corridor: nothing
+  EXPECT_GT(c(1, 1) * sigma * sigma, 0.5) << c;   // across it: most returns pin it
+  EXPECT_GT(c(2, 2), 0.0) << c;                   // and the heading
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues().minCoeff(), -1e-9);
 }

@@ -176,6 +176,16 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
                                 const Eigen::Vector3d* exclude = nullptr, double exclude_radius_m = 0.0,
                                 double exclude_angle_rad = 0.0);
 
+/// How sharply the score falls off around `pose` in each direction: minus its Hessian in (x [m],
+/// y [m], yaw [rad]) of the reference frame, by central differences (steps of half a cell, and the
+/// yaw that moves the points' mean range by half a cell), with negative eigenvalues set to 0. In
+/// score units per m^2 (per m rad, per rad^2). Along a plain corridor the x-x entry is about 0:
+/// the scan does not say where along it the robot is; a return on a surface square to a direction
+/// adds about 1 / (sigma^2 n) to it (sigma the grid's kernel, n the returns), so a direction that
+/// every return pins has about 1 / sigma^2.
+Eigen::Matrix3d scoreCurvature(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                               const Eigen::Vector3d& pose);
+
 /// Hill-climbs the interpolated score from `init` with steps from half a cell and `angular_step`,
 /// halved `halvings` times; returns the pose and writes its score. With `prior_weight` > 0 it climbs
 /// score - prior_weight * |xy - init xy|^2 [1/m^2] instead (a pull back to `init` where the score is

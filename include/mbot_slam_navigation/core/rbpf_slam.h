@@ -112,6 +112,7 @@ class RbpfSlam : public SlamBackend {
   Eigen::Vector3d currentPose() const override;
   /// With scan_odometry the pose follows the track at every scan, not only at updates.
   bool tracksEveryScan() const override { return tracker_ != nullptr; }
+  double trackingWeakestSigma() const override { return tracker_ ? tracker_->trackingWeakestSigma() : -1.0; }
   /// The best particle's trajectory, oldest first.
   std::vector<TrajectoryNode> trajectory() const override;
   /// The best particle's map.

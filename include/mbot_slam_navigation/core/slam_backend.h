@@ -44,6 +44,10 @@ class SlamBackend {
   /// True when currentPose() moves against odometry at every scan (scans are tracked), not only
   /// at updates: the node then publishes map -> odom for every scan.
   virtual bool tracksEveryScan() const { return false; }
+  /// [m] How weakly the last tracked scan's match fixed the robot's position: the standard
+  /// deviation along the direction it constrained least (GraphSlamStats::match_weakest_m); < 0
+  /// when scans are not tracked.
+  virtual double trackingWeakestSigma() const { return -1.0; }
   virtual int updates() const = 0;
 };
 
