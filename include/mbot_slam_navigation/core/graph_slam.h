@@ -103,8 +103,9 @@ struct GraphSlamParams {
   /// widens with local_search_sigmas.
   double local_search_window = 0.15;
   /// The window follows odometry's record (`~local_search_sigmas`): this many times r, the root
-  /// mean square of how far the best match moved the prediction over the last 200 scans (as
-  /// local_prior_points), within [local_search_window, local_search_max_window]. Odometry that
+  /// mean square of how far the best match moved the prediction over the last 200 scans, in every
+  /// direction (local_prior_points counts only those the matches pinned), within
+  /// [local_search_window, local_search_max_window]. Odometry that
   /// slips needs a window that its worst steps fit in: FR079's doorway turns are up to 0.16 m a scan
   /// off (r 24 mm) and with 0.15 m its map broke in some runs, with 0.25 m in none; the
   /// simulator's (r 3-4 mm) keeps 0.15 m, where a wider window let the tracked pose slip along a
