@@ -54,6 +54,11 @@ def wall_with_doors(x1, y1, x2, y2, doors: List[Tuple[float, float]]) -> List[Se
     return [(s, y1, e, y1) if horizontal else (x1, s, x1, e) for s, e in out if e - s > 1e-6]
 
 
+def rectangle(x0, y0, x1, y1) -> List[Seg]:
+    """The four walls of the rectangle [x0, x1] x [y0, y1], anticlockwise from its south-west corner."""
+    return [(x0, y0, x1, y0), (x1, y0, x1, y1), (x1, y1, x0, y1), (x0, y1, x0, y0)]
+
+
 class Plan:
     def __init__(self, name: str):
         self.name = name
@@ -136,7 +141,7 @@ def apartment(seed: int) -> Plan:
     p = Plan('apartment')
     W, H = 10.0, 8.0
     # outer walls
-    p.walls += [(0, 0, W, 0), (W, 0, W, H), (W, H, 0, H), (0, H, 0, 0)]
+    p.walls += rectangle(0, 0, W, H)
     hall_y0, hall_y1 = 3.4, 4.6  # a hallway 1.2 m wide across the flat
     split = rng.uniform(4.0, 6.0)  # where the rooms on each side divide
     p.spawn = (round(split / 2 + 0.5, 3), 2.75, 0.0)  # in the living room, between the coffee table and the hallway
@@ -172,7 +177,7 @@ def large(seed: int) -> Plan:
     W, H = 32.0, 22.0
     x0, y0 = -16.0, -11.0
     p.spawn = (0.0, 0.0, 0.0)
-    p.walls += [(x0, y0, x0 + W, y0), (x0 + W, y0, x0 + W, y0 + H), (x0 + W, y0 + H, x0, y0 + H), (x0, y0 + H, x0, y0)]
+    p.walls += rectangle(x0, y0, x0 + W, y0 + H)
     # a cross of corridors 3 m wide through the centre; four halls with two doors each
     c = 1.5
     halls = [('south-west hall', x0, -c, y0, -c), ('south-east hall', c, x0 + W, y0, -c),
@@ -205,7 +210,7 @@ def corridor(seed: int) -> Plan:
     rng = random.Random(seed)
     p = Plan('corridor')
     length, width = rng.uniform(40.0, 50.0), rng.uniform(2.0, 3.0)
-    p.walls += [(0, 0, length, 0), (length, 0, length, width), (length, width, 0, width), (0, width, 0, 0)]
+    p.walls += rectangle(0, 0, length, width)
     p.spawn = (1.5, round(width / 2, 3), 0.0)
     p.room('corridor', 0.0, length, 0.0, width)
     return p
@@ -216,7 +221,7 @@ def ring_plan(name: str, rng: random.Random, side_range, width_range) -> Tuple[P
     `width` inside it; the spawn point in the middle of the south corridor, facing east."""
     p = Plan(name)
     s, w = rng.uniform(*side_range), rng.uniform(*width_range)
-    p.walls += [(0, 0, s, 0), (s, 0, s, s), (s, s, 0, s), (0, s, 0, 0)]
+    p.walls += rectangle(0, 0, s, s)
     p.room('south corridor', 0.0, s, 0.0, w)
     p.room('north corridor', 0.0, s, s - w, s)
     p.room('west corridor', 0.0, w, w, s - w)
@@ -227,7 +232,7 @@ def ring_plan(name: str, rng: random.Random, side_range, width_range) -> Tuple[P
 
 def ring(seed: int) -> Plan:
     p, s, w = ring_plan('ring', random.Random(seed), (18.0, 22.0), (2.5, 3.5))
-    p.walls += [(w, w, s - w, w), (s - w, w, s - w, s - w), (s - w, s - w, w, s - w), (w, s - w, w, w)]
+    p.walls += rectangle(w, w, s - w, s - w)
     return p
 
 
@@ -235,7 +240,12 @@ def ring_rooms(seed: int) -> Plan:
     rng = random.Random(seed)
     p, s, w = ring_plan('ring_rooms', rng, (20.0, 24.0), (2.5, 3.0))
     a, b, m = w, s - w, s / 2  # the inner square [a, b]^2, four rooms split at m
-    door = lambda lo, hi: (lambda d: (d, d + 1.0))(rng.uniform(lo + 1.0, hi - 2.0))  # noqa: E731
+
+    def door(lo, hi):
+        """A door 1 m wide somewhere along [lo, hi], at least 1 m from either end."""
+        d = rng.uniform(lo + 1.0, hi - 2.0)
+        return d, d + 1.0
+
     # each room's door opens from the corridor along its outer side
     p.walls += wall_with_doors(a, a, b, a, [door(a, m), door(m, b)])        # south rooms' south wall
     p.walls += wall_with_doors(a, b, b, b, [door(a, m), door(m, b)])        # north rooms' north wall
@@ -250,7 +260,7 @@ def hall(seed: int) -> Plan:
     rng = random.Random(seed)
     p = Plan('hall')
     wx, wy = rng.uniform(30.0, 36.0), rng.uniform(30.0, 36.0)
-    p.walls += [(0, 0, wx, 0), (wx, 0, wx, wy), (wx, wy, 0, wy), (0, wy, 0, 0)]
+    p.walls += rectangle(0, 0, wx, wy)
     p.spawn = (2.0, round(wy / 2, 3), 0.0)
     p.room('hall', 0.0, wx, 0.0, wy)
     pillars, count = [], rng.randint(3, 5)
@@ -270,7 +280,7 @@ def gap() -> Plan:
     p = Plan('gap')
     p.spawn = (1.5, 1.5, 0.0)
     # west room 4 x 3 m; east room 4 x 3 m behind a wall whose only opening is 0.3 m wide
-    p.walls += [(0, 0, 8, 0), (8, 0, 8, 3), (8, 3, 0, 3), (0, 3, 0, 0)]
+    p.walls += rectangle(0, 0, 8, 3)
     p.walls += wall_with_doors(4, 0, 4, 3, [(1.35, 1.65)])
     p.room('west room', 0, 4, 0, 3)
     p.room('east room', 4, 8, 0, 3)
@@ -281,9 +291,8 @@ def boxed() -> Plan:
     p = Plan('boxed')
     p.spawn = (0.0, 0.0, 0.0)
     # the mbot (radius 0.2 m) in a 0.7 m x 0.7 m box, inside a room it cannot reach
-    p.walls += [(-0.35, -0.35, 0.35, -0.35), (0.35, -0.35, 0.35, 0.35), (0.35, 0.35, -0.35, 0.35),
-                (-0.35, 0.35, -0.35, -0.35)]
-    p.walls += [(-3, -3, 3, -3), (3, -3, 3, 3), (3, 3, -3, 3), (-3, 3, -3, -3)]
+    p.walls += rectangle(-0.35, -0.35, 0.35, 0.35)
+    p.walls += rectangle(-3, -3, 3, 3)
     p.room('box', -0.35, 0.35, -0.35, 0.35)
     return p
 

@@ -6,12 +6,12 @@
 // driven must come out within 0.5%, with exact odometry and with the simulator's wheel slip. The
 // heading is held to 0.25 degree: each node is matched against the nodes before it, and that chain
 // wanders by about 0.2 degree over the 40 m whatever odometry says (0.1 degree is the aim).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <random>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -112,6 +112,8 @@ World2D plainCorridor() {
 }
 
 void expectStraight(const RunResult& r, const char* what) {
+  ::testing::Test::RecordProperty("worst_heading_deg", std::to_string(r.worst_heading_deg));
+  ::testing::Test::RecordProperty("distance_error", std::to_string(r.distance_error));
   std::printf("%s: worst heading error %.3f deg, distance error %+.3f%%, worst lateral error %.3f m, "
               "weakest direction's sigma %.3f m (median)\n", what, r.worst_heading_deg, 100.0 * r.distance_error,
               r.worst_lateral_m, r.weakest_sigma_m);
@@ -127,15 +129,11 @@ void expectStraight(const RunResult& r, const char* what) {
 
 TEST(StraightRuns, AlongOnePlainWallWithExactOdometry) {
   const RunResult r = driveStraight(plainWall(), {0.0, 0.0, 0.0}, 0.0, 3);
-  RecordProperty("worst_heading_deg", std::to_string(r.worst_heading_deg));
-  RecordProperty("distance_error", std::to_string(r.distance_error));
   expectStraight(r, "one wall, exact odometry");
 }
 
 TEST(StraightRuns, AlongAPlainCorridorWithExactOdometry) {
   const RunResult r = driveStraight(plainCorridor(), {0.0, 0.3, 0.0}, 0.0, 4);
-  RecordProperty("worst_heading_deg", std::to_string(r.worst_heading_deg));
-  RecordProperty("distance_error", std::to_string(r.distance_error));
   expectStraight(r, "corridor, exact odometry");
 }
 
@@ -143,15 +141,11 @@ TEST(StraightRuns, AlongOnePlainWallWithTheSimulatorsWheelSlip) {
   // The simulator's default slip (gazebo_sim ~odometry_slip_stddev): odometry's heading wanders by
   // about a degree over the run; the scan must hold it.
   const RunResult r = driveStraight(plainWall(), {0.0, 0.0, 0.0}, 0.02, 5);
-  RecordProperty("worst_heading_deg", std::to_string(r.worst_heading_deg));
-  RecordProperty("distance_error", std::to_string(r.distance_error));
   expectStraight(r, "one wall, wheel slip");
 }
 
 TEST(StraightRuns, AlongAPlainCorridorWithTheSimulatorsWheelSlip) {
   const RunResult r = driveStraight(plainCorridor(), {0.0, 0.3, 0.0}, 0.02, 6);
-  RecordProperty("worst_heading_deg", std::to_string(r.worst_heading_deg));
-  RecordProperty("distance_error", std::to_string(r.distance_error));
   expectStraight(r, "corridor, wheel slip");
 }
 
