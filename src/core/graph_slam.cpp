@@ -157,7 +157,7 @@ bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, 
         // corridor and pulls the match across the wall: those returns are left out, the rest
         // (what no scan saw) kept. Replays of 20 large-floor runs: worst map 99.1% walls, 97.8%
         // without. (Once the local map holds a node from inside the room this no longer applies:
-        // one recorded run still moved 0.1 m across a wall there; README, SLAM.)
+        // one recorded run still moved 0.1 m across a wall there; docs/slam.md.)
         near = local_seen_.notBehindOf(near, predicted, params_.delta, kWallBehind, normals);
       }
     }

@@ -16,7 +16,7 @@
 // a likelihood grid of the last nodes' scans): the particles then spread from a prediction a few
 // centimetres off, not the tens of centimetres of odometry that slips in a turn. On FR079 the
 // filter with wheel odometry is lost (1.9 m, as ROS's gmapping), with scan odometry it is not
-// (README, SLAM). Off, the filter is gmapping's.
+// (docs/slam.md). Off, the filter is gmapping's.
 // Frames: odometry poses are base_footprint in odom; particle poses are base_footprint in map.
 #pragma once
 
@@ -40,7 +40,7 @@ namespace core {
 /// which are for wheels. The track drifts about a tenth as much; with gmapping's noise the particles
 /// spread far wider than its error, walk apart along the corridors and the published best particle
 /// changes between lineages a metre apart. Offline on ACES, seeds 0-7, as each scan was processed:
-/// median 0.068 m against 0.091 m with gmapping's noise, which lost the map in 2 of 8 (README, SLAM).
+/// median 0.068 m against 0.091 m with gmapping's noise, which lost the map in 2 of 8 (docs/slam.md).
 MotionModelParams scanOdometryMotion();
 
 struct RbpfParams {
@@ -70,7 +70,7 @@ struct RbpfParams {
   /// resampling weighs with (log-likelihood / (ogain * particles)): 4 is a weight 55 times theirs.
   /// 0 is gmapping's choice, the highest accumulated weight at every update. A change of best
   /// particle moves the published pose by the distance between the two lineages, often a metre
-  /// before a loop closes, and those jumps were much of the online error (README, SLAM).
+  /// before a loop closes, and those jumps were much of the online error (docs/slam.md).
   double best_switch_margin = 4.0;
   /// The track's local SLAM (its `local_*` values, linearUpdate, angularUpdate); its matcher,
   /// delta and map extent are the filter's, and closures are off whatever this says.
