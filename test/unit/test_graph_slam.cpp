@@ -15,6 +15,7 @@
 #include "mbot_slam_navigation/core/scan_matcher.h"
 #include "mbot_slam_navigation/core/slam_grid.h"
 #include "mbot_slam_navigation/core/world2d.h"
+#include "mbot_laser.h"
 
 using namespace mbot::core;
 
@@ -533,17 +534,7 @@ World2D officeCorridor() {
 }  // namespace
 
 namespace {
-/// The mbot's laser as the simulator gives it: 360 beams all round, 0.1-6 m, 1 cm noise.
-LaserScan mbotScanAt(const World2D& w, const Eigen::Vector3d& pose, std::mt19937& rng) {
-  LaserScan s;
-  s.angle_min_rad = -M_PI;
-  s.angle_increment_rad = 2.0 * M_PI / 360.0;
-  s.range_min_m = 0.1;
-  s.range_max_m = 6.0;
-  s.ranges_m.resize(360);
-  w.castScan(pose, s.angle_min_rad, s.angle_increment_rad, 360, 0.1, 6.0, 0.01, 0.0, rng, s.ranges_m.data());
-  return s;
-}
+using test_fixtures::mbotScanAt;
 
 /// Down officeCorridor() and back: east 18.5 m in the lane at y = lane_gap / 2, a U-turn into the
 /// lane at -lane_gap / 2, west 18.5 m; 0.037 m per scan.
