@@ -360,6 +360,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("threads", &RbpfParams::threads)
       .def_readwrite("best_switch_margin", &RbpfParams::best_switch_margin)
       .def_readwrite("tracking", &RbpfParams::tracking)
+      .def("share_with", &RbpfParams::shareWith, py::arg("graph"),
+           "Gives the graph (or the track) what both backends share: matcher, angularUpdate, temporalUpdate, delta, extent.")
       .def("validate", &RbpfParams::validate);
   // Both backends share the SlamBackend methods, bound once on the base class.
   using mbot::core::SlamBackend;

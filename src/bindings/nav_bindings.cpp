@@ -9,6 +9,7 @@
 #include "mbot_slam_navigation/core/layered_costmap.h"
 #include "mbot_slam_navigation/core/move_base_config.h"
 #include "mbot_slam_navigation/core/params.h"
+#include "mbot_slam_navigation/core/slam_config.h"
 #include "mbot_slam_navigation/core/trajectory_controller.h"
 
 namespace py = pybind11;
@@ -84,20 +85,49 @@ void bindNavigation(py::module& m) {
       .def("where", &ParamReader::where)
       .def("has", &ParamReader::has)
       .def("warn", &ParamReader::warn)
-      .def("raw", [](ParamReader& r, const std::string& key, py::object fallback) { return fromParam(r.raw(key, toParam(fallback))); },
-           py::arg("key"), py::arg("default") = py::none())
-      .def("number", [](ParamReader& r, const std::string& key, double fallback, std::optional<double> minimum, bool positive) {
-             return r.number(key, fallback, minimum, positive);
-           }, py::arg("key"), py::arg("default"), py::arg("minimum") = py::none(), py::arg("positive") = false)
-      .def("integer", [](ParamReader& r, const std::string& key, long fallback, std::optional<long> minimum) {
-             return r.integer(key, fallback, minimum);
-           }, py::arg("key"), py::arg("default"), py::arg("minimum") = py::none())
-      .def("boolean", &ParamReader::boolean, py::arg("key"), py::arg("default"))
-      .def("string", &ParamReader::string, py::arg("key"), py::arg("default"))
-      .def("frame", &ParamReader::frame, py::arg("key"), py::arg("default"))
-      .def("deprecated", &ParamReader::deprecated, py::arg("new"), py::arg("old"), py::arg("default"))
+      .def("raw", [](ParamReader& r, const std::string& key, py::object fallback, const char* doc, const char* type) {
+             return fromParam(r.raw(key, toParam(fallback), doc, type));
+           }, py::arg("key"), py::arg("default") = py::none(), py::arg("doc") = nullptr, py::arg("type") = "any")
+      .def("number", [](ParamReader& r, const std::string& key, double fallback, const char* doc, std::optional<double> minimum,
+                        bool positive) { return r.number(key, fallback, doc, minimum, positive); },
+           py::arg("key"), py::arg("default"), py::arg("doc") = nullptr, py::arg("minimum") = py::none(),
+           py::arg("positive") = false)
+      .def("integer", [](ParamReader& r, const std::string& key, long fallback, const char* doc, std::optional<long> minimum) {
+             return r.integer(key, fallback, doc, minimum);
+           }, py::arg("key"), py::arg("default"), py::arg("doc") = nullptr, py::arg("minimum") = py::none())
+      .def("boolean", &ParamReader::boolean, py::arg("key"), py::arg("default"), py::arg("doc") = nullptr)
+      .def("string", &ParamReader::string, py::arg("key"), py::arg("default"), py::arg("doc") = nullptr)
+      .def("frame", &ParamReader::frame, py::arg("key"), py::arg("default"), py::arg("doc") = nullptr)
+      .def("ignored", &ParamReader::ignored, py::arg("key"), py::arg("why"))
+      .def("deprecated", &ParamReader::deprecated, py::arg("new"), py::arg("old"), py::arg("default"),
+           py::arg("doc") = nullptr)
       .def("report_unknown", &ParamReader::reportUnknown, py::arg("skip") = std::set<std::string>(),
            py::arg("elsewhere") = std::map<std::string, std::string>());
+
+  // The reads of every ParamReader on this thread while the catalog is open, for the reference
+  // pages (tools/node_docs.py): `with ParamCatalog() as c: ...; c.declarations`.
+  py::class_<ParamCatalog>(m, "ParamCatalog")
+      .def(py::init<>())
+      .def("__enter__", [](ParamCatalog& c) -> ParamCatalog& { return c; }, py::return_value_policy::reference)
+      .def("__exit__", [](ParamCatalog& c, py::object, py::object, py::object) {
+        c.close();
+        return false;
+      })
+      .def_property_readonly("declarations", [](const ParamCatalog& c) {
+        py::list out;
+        for (const auto& d : c.declarations()) {
+          py::dict e;
+          e["ns"] = d.ns;
+          e["key"] = d.key;
+          e["type"] = d.type;
+          e["default"] = d.default_repr;
+          e["bounds"] = d.bounds;
+          e["unit"] = d.unit;
+          e["meaning"] = d.meaning;
+          out.append(e);
+        }
+        return out;
+      });
 
   py::class_<ObservationSourceConfig>(m, "ObservationSourceConfig")
       .def_readonly("name", &ObservationSourceConfig::name)
@@ -222,4 +252,20 @@ void bindNavigation(py::module& m) {
   m.def("read_move_base_config", [](py::object values, const std::string& ns, py::object warn, double circumscribed) {
     return readMoveBaseConfig(toParam(values), ns, warnOf(warn), circumscribed);
   }, py::arg("values"), py::arg("ns"), py::arg("warn"), py::arg("circumscribed_radius"));
+
+  py::class_<SlamConfig>(m, "SlamConfig")
+      .def_readonly("base_frame", &SlamConfig::base_frame)
+      .def_readonly("odom_frame", &SlamConfig::odom_frame)
+      .def_readonly("map_frame", &SlamConfig::map_frame)
+      .def_readonly("map_update_interval", &SlamConfig::map_update_interval)
+      .def_readonly("occ_thresh", &SlamConfig::occ_thresh)
+      .def_readonly("backend", &SlamConfig::backend)
+      .def_readonly("rbpf", &SlamConfig::rbpf)
+      .def_readonly("graph", &SlamConfig::graph);
+  m.def("read_slam_config", [](py::object values, const std::string& ns, py::object warn, double default_max_range) {
+    std::vector<std::string> unknown;
+    SlamConfig c = readSlamConfig(toParam(values), ns, warnOf(warn), default_max_range, &unknown);
+    return std::make_pair(c, unknown);
+  }, "slam_gmapping's parameters (core/slam_config.h) and the keys no one reads.", py::arg("values"), py::arg("ns"),
+     py::arg("warn"), py::arg("default_max_range"));
 }

@@ -36,6 +36,13 @@ std::vector<std::string> keysOf(const std::map<std::string, std::string>& m) {
   return out;
 }
 
+const char* const kFootprintDoc = "[m] the robot's outline as [[x, y], ...] in the base frame (or robot_radius)";
+const char* const kRadiusDoc = "[m] radius of a round robot, used when footprint is not set";
+const char* const kPluginsDoc = "the layers in order, [{name: ..., type: costmap_2d::StaticLayer}, ...] "
+                                "(Static, Obstacle, Voxel as 2D, Inflation); without it, the pre-Hydro keys";
+const char* const kEnabledDoc = "the layer is used";
+constexpr double kDefaultRobotRadius = 0.46;  // [m] costmap_2d's
+
 // A layer's key, read from its own namespace or, when only set there, the costmap's top level.
 template <class F>
 auto fallback(ParamReader& layer, ParamReader& top, const std::string& key, F read) {
@@ -47,24 +54,40 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
   ParamReader r(values, layer.ns() + "/" + name, warn);
   ObservationSourceConfig s;
   s.name = name;
-  s.topic = r.string("topic", name);
-  const ParamValue sf = r.raw("sensor_frame", ParamValue::ofString(""));
-  s.sensor_frame = sf.type == ParamValue::Type::kString && sf.s.empty() ? "" : r.frame("sensor_frame", "");
-  s.observation_persistence = r.number("observation_persistence", 0.0, 0.0);
-  s.expected_update_rate = r.number("expected_update_rate", kUnsetExpectedUpdateRate, 0.0);
-  const std::string data_type = r.string("data_type", "PointCloud");
+  s.topic = r.string("topic", name, "the sensor's topic (default: the source's name)");
+  const char* frame_doc = "frame of the sensor ('': each message's header frame)";
+  const ParamValue sf = r.raw("sensor_frame", ParamValue::ofString(""), frame_doc, "frame");
+  s.sensor_frame = sf.type == ParamValue::Type::kString && sf.s.empty() ? "" : r.frame("sensor_frame", "", frame_doc);
+  s.observation_persistence = r.number("observation_persistence", s.observation_persistence,
+                                       "[s] how long a reading is kept (0: the latest only)", 0.0);
+  s.expected_update_rate = r.number("expected_update_rate", kUnsetExpectedUpdateRate,
+                                    "[s] longest gap between readings before the sensor counts as stale and the robot "
+                                    "stops (0: never; costmap_2d's default 0)",
+                                    0.0);
+  const std::string data_type = r.string("data_type", "PointCloud", "message type: only LaserScan is supported here");
   if (data_type != "LaserScan") {
     throw ParamError("parameter " + r.where("data_type") + ": data_type \"" + data_type +
                      "\" is not supported; only LaserScan sources are");
   }
-  s.clearing = r.boolean("clearing", false);
-  s.marking = r.boolean("marking", true);
-  s.max_obstacle_height = r.number("max_obstacle_height", layer.number("max_obstacle_height", 2.0));
-  s.min_obstacle_height = r.number("min_obstacle_height", 0.0);
-  s.obstacle_range = r.number("obstacle_range", layer.number("obstacle_range", 2.5, std::nullopt, true), std::nullopt, true);
-  s.raytrace_range = r.number("raytrace_range", layer.number("raytrace_range", 3.0, std::nullopt, true), std::nullopt, true);
-  s.inf_is_valid = r.boolean("inf_is_valid", true);
-  s.too_close_is_obstacle = r.boolean("too_close_is_obstacle", true);
+  s.clearing = r.boolean("clearing", s.clearing, "clear the cells along each beam");
+  s.marking = r.boolean("marking", s.marking, "mark the cell where each beam ends");
+  s.max_obstacle_height =
+      r.number("max_obstacle_height",
+               layer.number("max_obstacle_height", s.max_obstacle_height, "[m] highest reading that counts (layer default)"),
+               "[m] highest reading that counts");
+  s.min_obstacle_height = r.number("min_obstacle_height", s.min_obstacle_height, "[m] lowest reading that counts");
+  s.obstacle_range = r.number("obstacle_range",
+                              layer.number("obstacle_range", s.obstacle_range, "[m] farthest reading that marks (layer default)",
+                                           std::nullopt, true),
+                              "[m] farthest reading that marks an obstacle", std::nullopt, true);
+  s.raytrace_range = r.number("raytrace_range",
+                              layer.number("raytrace_range", s.raytrace_range, "[m] farthest beam that clears (layer default)",
+                                           std::nullopt, true),
+                              "[m] farthest a beam clears free space", std::nullopt, true);
+  s.inf_is_valid = r.boolean("inf_is_valid", s.inf_is_valid,
+                             "an infinite range clears the beam's whole length (ROS's default false: it clears nothing)");
+  s.too_close_is_obstacle = r.boolean("too_close_is_obstacle", s.too_close_is_obstacle,
+                                      "a -inf range (nearer than range_min) marks an obstacle at range_min");
   r.reportUnknown();
   return s;
 }
@@ -115,32 +138,35 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
   while (!prefix.empty() && prefix.back() == '/') prefix.pop_back();
   const std::string ns = prefix + "/" + name;
   ParamReader r(values, ns, warn);
-  c.global_frame = r.frame("global_frame", "map");
-  c.robot_base_frame = r.frame("robot_base_frame", "base_link");
-  c.transform_tolerance = r.number("transform_tolerance", 0.3, 0.0);
-  c.update_frequency = r.number("update_frequency", 5.0, 0.0);
-  c.publish_frequency = r.number("publish_frequency", 1.0, 0.0);
-  c.rolling_window = r.boolean("rolling_window", false);
-  c.always_send_full_costmap = r.boolean("always_send_full_costmap", false);
-  c.width = r.number("width", 10.0, std::nullopt, true);
-  c.height = r.number("height", 10.0, std::nullopt, true);
-  c.resolution = r.number("resolution", 0.05, std::nullopt, true);
-  c.origin_x = r.number("origin_x", 0.0);
-  c.origin_y = r.number("origin_y", 0.0);
-  c.footprint_padding = r.number("footprint_padding", 0.01);
+  c.global_frame = r.frame("global_frame", c.global_frame, "frame the costmap lies in");
+  c.robot_base_frame = r.frame("robot_base_frame", c.robot_base_frame, "the robot's base frame");
+  c.transform_tolerance = r.number("transform_tolerance", c.transform_tolerance,
+                                   "[s] how old the robot's pose may be before the costmap stops updating", 0.0);
+  c.update_frequency = r.number("update_frequency", c.update_frequency, "[Hz] how often the layers are updated", 0.0);
+  c.publish_frequency = r.number("publish_frequency", c.publish_frequency,
+                                 "[Hz] how often the costmap is published (ROS's default 0: never)", 0.0);
+  c.rolling_window = r.boolean("rolling_window", c.rolling_window, "the costmap moves with the robot, centred on it");
+  c.always_send_full_costmap = r.boolean("always_send_full_costmap", c.always_send_full_costmap,
+                                         "publish the whole costmap every time instead of costmap_updates");
+  c.width = r.number("width", c.width, "[m] size along x (rolling window, or no static map)", std::nullopt, true);
+  c.height = r.number("height", c.height, "[m] size along y (rolling window, or no static map)", std::nullopt, true);
+  c.resolution = r.number("resolution", c.resolution, "[m/cell] cell size", std::nullopt, true);
+  c.origin_x = r.number("origin_x", c.origin_x, "[m] x of the lower-left corner (without a static map)");
+  c.origin_y = r.number("origin_y", c.origin_y, "[m] y of the lower-left corner (without a static map)");
+  c.footprint_padding = r.number("footprint_padding", c.footprint_padding, "[m] added around the footprint");
   Footprint footprint;
   const ParamValue* fp = r.values().get("footprint");
   const bool fp_empty = !fp || fp->type == ParamValue::Type::kNone || (fp->type == ParamValue::Type::kList && fp->items.empty()) ||
                         (fp->type == ParamValue::Type::kString && (fp->s == "[]" || fp->s.empty()));
   if (!fp_empty) {
-    footprint = parseFootprint(r.raw("footprint"), r.where("footprint"));
+    footprint = parseFootprint(r.raw("footprint", ParamValue::ofList(), kFootprintDoc, "list"), r.where("footprint"));
     if (r.has("robot_radius")) {
-      r.markRead("robot_radius");
+      r.number("robot_radius", kDefaultRobotRadius, kRadiusDoc);
       warn(ns + ": both footprint and robot_radius are set; the footprint polygon is used");
     }
   } else {
-    r.markRead("footprint");
-    footprint = circleFootprint(r.number("robot_radius", 0.46, std::nullopt, true));
+    r.raw("footprint", ParamValue::ofList(), kFootprintDoc, "list");
+    footprint = circleFootprint(r.number("robot_radius", kDefaultRobotRadius, kRadiusDoc, std::nullopt, true));
   }
   try {
     validateFootprint(footprint);
@@ -155,7 +181,7 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
   std::vector<std::tuple<std::string, std::string, std::unique_ptr<ParamReader>>> layers;
   std::set<std::string> sub_namespaces;
   if (r.has("plugins")) {
-    const ParamValue plugins = r.raw("plugins");
+    const ParamValue plugins = r.raw("plugins", ParamValue::ofList(), kPluginsDoc, "list");
     if (plugins.type != ParamValue::Type::kList) {
       throw ParamError("parameter " + r.where("plugins") + " must be a list of {name, type}, got " + plugins.repr());
     }
@@ -183,8 +209,11 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
     }
   } else {
     // Pre-Hydro: the layers ROS builds from the old keys, which live at the top level.
-    if (r.boolean("static_map", true)) layers.emplace_back("static_layer", "static", nullptr);
-    const std::string map_type = r.string("map_type", "costmap");
+    r.raw("plugins", ParamValue::ofList(), kPluginsDoc, "list");
+    if (r.boolean("static_map", true, "without plugins: build a static layer from the map topic")) {
+      layers.emplace_back("static_layer", "static", nullptr);
+    }
+    const std::string map_type = r.string("map_type", "costmap", "without plugins: costmap or voxel (both 2D here)");
     if (map_type != "costmap" && map_type != "voxel") {
       throw ParamError("parameter " + r.where("map_type") + " must be costmap or voxel, got \"" + map_type + "\"");
     }
@@ -197,26 +226,43 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
     std::set<std::string> skip;
     if (kind == "static") {
       StaticLayerConfig s;
+      const StaticLayerConfig d;
       s.name = layer_name;
-      s.map_topic = fallback(lr, r, "map_topic", [](ParamReader& p) { return p.string("map_topic", "map"); });
-      s.first_map_only = fallback(lr, r, "first_map_only", [](ParamReader& p) { return p.boolean("first_map_only", false); });
-      s.subscribe_to_updates =
-          fallback(lr, r, "subscribe_to_updates", [](ParamReader& p) { return p.boolean("subscribe_to_updates", false); });
-      s.track_unknown_space =
-          fallback(lr, r, "track_unknown_space", [](ParamReader& p) { return p.boolean("track_unknown_space", true); });
-      s.use_maximum = fallback(lr, r, "use_maximum", [](ParamReader& p) { return p.boolean("use_maximum", false); });
-      s.lethal_cost_threshold = static_cast<int>(
-          fallback(lr, r, "lethal_cost_threshold", [](ParamReader& p) { return p.integer("lethal_cost_threshold", 100, 0); }));
-      s.unknown_cost_value =
-          static_cast<int>(fallback(lr, r, "unknown_cost_value", [](ParamReader& p) { return p.integer("unknown_cost_value", -1); }));
-      s.trinary_costmap = fallback(lr, r, "trinary_costmap", [](ParamReader& p) { return p.boolean("trinary_costmap", true); });
-      s.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      s.map_topic = fallback(lr, r, "map_topic", [&](ParamReader& p) {
+        return p.string("map_topic", d.map_topic, "static layer: the map's topic");
+      });
+      s.first_map_only = fallback(lr, r, "first_map_only", [&](ParamReader& p) {
+        return p.boolean("first_map_only", d.first_map_only, "static layer: keep the first map, ignore later ones");
+      });
+      s.subscribe_to_updates = fallback(lr, r, "subscribe_to_updates", [&](ParamReader& p) {
+        return p.boolean("subscribe_to_updates", d.subscribe_to_updates, "static layer: also read <map_topic>_updates");
+      });
+      s.track_unknown_space = fallback(lr, r, "track_unknown_space", [&](ParamReader& p) {
+        return p.boolean("track_unknown_space", d.track_unknown_space,
+                         "static layer: unknown map cells stay unknown (else free); obstacle layer: cells start unknown");
+      });
+      s.use_maximum = fallback(lr, r, "use_maximum", [&](ParamReader& p) {
+        return p.boolean("use_maximum", d.use_maximum, "static layer: combine by maximum instead of overwriting");
+      });
+      s.lethal_cost_threshold = static_cast<int>(fallback(lr, r, "lethal_cost_threshold", [&](ParamReader& p) {
+        return p.integer("lethal_cost_threshold", d.lethal_cost_threshold,
+                         "static layer: map value (0-100) from which a cell is lethal", 0);
+      }));
+      s.unknown_cost_value = static_cast<int>(fallback(lr, r, "unknown_cost_value", [&](ParamReader& p) {
+        return p.integer("unknown_cost_value", d.unknown_cost_value, "static layer: map value that means unknown");
+      }));
+      s.trinary_costmap = fallback(lr, r, "trinary_costmap", [&](ParamReader& p) {
+        return p.boolean("trinary_costmap", d.trinary_costmap, "static layer: map cells are free, lethal or unknown only");
+      });
+      s.enabled = fallback(lr, r, "enabled", [&](ParamReader& p) { return p.boolean("enabled", d.enabled, kEnabledDoc); });
       c.static_layer = s;
     } else if (kind == "obstacle") {
       ObstacleLayerConfig o;
+      const ObstacleLayerConfig d;
       o.name = layer_name;
-      const std::string names =
-          fallback(lr, r, "observation_sources", [](ParamReader& p) { return p.string("observation_sources", ""); });
+      const std::string names = fallback(lr, r, "observation_sources", [](ParamReader& p) {
+        return p.string("observation_sources", "", "obstacle layer: the sensors' names, space-separated; each a namespace");
+      });
       // The layer's range keys are the defaults of its sources.
       for (const char* key : {"obstacle_range", "raytrace_range", "max_obstacle_height"}) {
         if (&lr != &r && !lr.has(key) && r.has(key)) lr.values().fields[key] = *r.values().get(key);
@@ -235,30 +281,42 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
         skip.insert(source);
         sub_namespaces.insert(source);
       }
-      o.track_unknown_space =
-          fallback(lr, r, "track_unknown_space", [](ParamReader& p) { return p.boolean("track_unknown_space", false); });
-      o.footprint_clearing_enabled = fallback(lr, r, "footprint_clearing_enabled",
-                                              [](ParamReader& p) { return p.boolean("footprint_clearing_enabled", true); });
-      o.combination_method =
-          static_cast<int>(fallback(lr, r, "combination_method", [](ParamReader& p) { return p.integer("combination_method", 1); }));
-      o.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      o.track_unknown_space = fallback(lr, r, "track_unknown_space", [&](ParamReader& p) {
+        return p.boolean("track_unknown_space", d.track_unknown_space,
+                         "obstacle layer: cells start unknown (else free); static layer: unknown map cells stay unknown");
+      });
+      o.footprint_clearing_enabled = fallback(lr, r, "footprint_clearing_enabled", [&](ParamReader& p) {
+        return p.boolean("footprint_clearing_enabled", d.footprint_clearing_enabled,
+                         "obstacle layer: clear the cells under the robot's footprint");
+      });
+      o.combination_method = static_cast<int>(fallback(lr, r, "combination_method", [&](ParamReader& p) {
+        return p.integer("combination_method", d.combination_method, "obstacle layer: 0 overwrite, 1 maximum");
+      }));
+      o.enabled = fallback(lr, r, "enabled", [&](ParamReader& p) { return p.boolean("enabled", d.enabled, kEnabledDoc); });
       c.obstacle_layer = o;
     } else {
       InflationLayerConfig f;
+      const InflationLayerConfig d;
       f.name = layer_name;
-      f.inflation_radius =
-          fallback(lr, r, "inflation_radius", [](ParamReader& p) { return p.number("inflation_radius", 0.55, 0.0); });
-      f.cost_scaling_factor =
-          fallback(lr, r, "cost_scaling_factor", [](ParamReader& p) { return p.number("cost_scaling_factor", 10.0, 0.0); });
-      f.inflate_unknown = fallback(lr, r, "inflate_unknown", [](ParamReader& p) { return p.boolean("inflate_unknown", false); });
-      f.enabled = fallback(lr, r, "enabled", [](ParamReader& p) { return p.boolean("enabled", true); });
+      f.inflation_radius = fallback(lr, r, "inflation_radius", [&](ParamReader& p) {
+        return p.number("inflation_radius", d.inflation_radius, "[m] inflation layer: how far from obstacles cost is added",
+                        0.0);
+      });
+      f.cost_scaling_factor = fallback(lr, r, "cost_scaling_factor", [&](ParamReader& p) {
+        return p.number("cost_scaling_factor", d.cost_scaling_factor,
+                        "[1/m] inflation layer: how fast the cost falls with distance", 0.0);
+      });
+      f.inflate_unknown = fallback(lr, r, "inflate_unknown", [&](ParamReader& p) {
+        return p.boolean("inflate_unknown", d.inflate_unknown, "inflation layer: inflate around unknown cells too");
+      });
+      f.enabled = fallback(lr, r, "enabled", [&](ParamReader& p) { return p.boolean("enabled", d.enabled, kEnabledDoc); });
       c.inflation_layer = f;
     }
     if (&lr != &r) lr.reportUnknown(skip);
   }
   // Voxel-layer keys are accepted (the layer is 2D here) but not reported as unknown.
   for (const char* key : {"origin_z", "z_resolution", "z_voxels", "unknown_threshold", "mark_threshold", "publish_voxel_map"}) {
-    r.markRead(key);
+    r.ignored(key, "a voxel layer's key; the obstacle layer is 2D here (the simulated lasers are planar)");
   }
   std::map<std::string, std::string> elsewhere;
   for (const auto& k : kMoveBaseKeys) elsewhere[k] = "move_base";

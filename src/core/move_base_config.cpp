@@ -26,6 +26,10 @@ std::vector<std::string> keysOf(const std::map<std::string, std::string>& m) {
   for (const auto& [k, _] : m) out.push_back(k);
   return out;
 }
+const char* const kRecoveriesDoc =
+    "the recoveries in order, [{name: ..., type: ...}, ...]; default: conservative_reset, rotate_recovery, back_up, "
+    "aggressive_reset, rotate_recovery";
+
 RecoveryKind kindOf(const std::string& type) {
   if (type == kRecoveryTypes[0]) return RecoveryKind::kClearCostmap;
   if (type == kRecoveryTypes[1]) return RecoveryKind::kRotate;
@@ -38,22 +42,44 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
   const Warn warn = orIgnore(warn_or_empty);
   MoveBaseConfig c;
   ParamReader r(values, ns, warn);
-  c.controller_frequency = r.number("controller_frequency", 20.0, std::nullopt, true);
-  c.planner_frequency = r.number("planner_frequency", 0.0, 0.0);
-  c.controller_patience = r.number("controller_patience", 15.0, 0.0);
-  c.planner_patience = r.number("planner_patience", 5.0, 0.0);
-  c.max_planning_retries = r.integer("max_planning_retries", -1);
-  c.oscillation_timeout = r.number("oscillation_timeout", 20.0, 0.0);
-  c.oscillation_distance = r.number("oscillation_distance", 0.5, 0.0);
-  c.progress_timeout = r.number("progress_timeout", 60.0, 0.0);
-  c.recovery_behavior_enabled = r.boolean("recovery_behavior_enabled", true);
-  c.clearing_rotation_allowed = r.boolean("clearing_rotation_allowed", true);
-  c.shutdown_costmaps = r.boolean("shutdown_costmaps", false);
-  c.conservative_reset_dist = r.number("conservative_reset_dist", 3.0, 0.0);
-  c.make_plan_clear_costmap = r.boolean("make_plan_clear_costmap", true);
-  c.make_plan_add_unreachable_goal = r.boolean("make_plan_add_unreachable_goal", true);
-  c.global_type = r.string("base_global_planner", "navfn/NavfnROS");
-  c.local_type = r.string("base_local_planner", "base_local_planner/TrajectoryPlannerROS");
+  c.controller_frequency = r.number("controller_frequency", c.controller_frequency,
+                                    "[Hz] how often the local planner runs and velocity commands are sent", std::nullopt, true);
+  c.planner_frequency = r.number("planner_frequency", c.planner_frequency,
+                                 "[Hz] how often the global plan is made again (0: on a new goal and when the local planner fails)",
+                                 0.0);
+  c.controller_patience = r.number("controller_patience", c.controller_patience,
+                                   "[s] how long without a valid velocity command before the recoveries run", 0.0);
+  c.planner_patience = r.number("planner_patience", c.planner_patience,
+                                "[s] how long without a valid plan before the recoveries run", 0.0);
+  c.max_planning_retries = r.integer("max_planning_retries", c.max_planning_retries,
+                                     "planning failures before the recoveries run (-1: planner_patience decides)");
+  c.oscillation_timeout = r.number("oscillation_timeout", c.oscillation_timeout,
+                                   "[s] how long without moving oscillation_distance before the recoveries run (0: never; "
+                                   "ROS's default 0)",
+                                   0.0);
+  c.oscillation_distance = r.number("oscillation_distance", c.oscillation_distance,
+                                    "[m] travel that resets the oscillation timer", 0.0);
+  c.progress_timeout = r.number("progress_timeout", c.progress_timeout,
+                                "[s] ours: how long without the path to the goal getting 0.25 m shorter before the recoveries "
+                                "run, and after the last, the goal is aborted (0: never)",
+                                0.0);
+  c.recovery_behavior_enabled = r.boolean("recovery_behavior_enabled", c.recovery_behavior_enabled,
+                                          "run the recovery behaviours when stuck (else abort at once)");
+  c.clearing_rotation_allowed = r.boolean("clearing_rotation_allowed", c.clearing_rotation_allowed,
+                                          "the default recoveries include turning on the spot");
+  c.shutdown_costmaps = r.boolean("shutdown_costmaps", c.shutdown_costmaps, "stop the costmaps while there is no goal");
+  c.conservative_reset_dist = r.number("conservative_reset_dist", c.conservative_reset_dist,
+                                       "[m] the default conservative_reset keeps obstacles within this square around the robot",
+                                       0.0);
+  c.make_plan_clear_costmap = r.boolean("make_plan_clear_costmap", c.make_plan_clear_costmap,
+                                        "the make_plan service clears the costmap around the robot first");
+  c.make_plan_add_unreachable_goal = r.boolean("make_plan_add_unreachable_goal", c.make_plan_add_unreachable_goal,
+                                               "make_plan appends the goal to a plan that ends short of it");
+  c.global_type = r.string("base_global_planner", c.global_type,
+                           "the global planner: navfn/NavfnROS or global_planner/GlobalPlanner");
+  c.local_type = r.string("base_local_planner", c.local_type,
+                          "the local planner: base_local_planner/TrajectoryPlannerROS or dwa_local_planner/DWAPlannerROS "
+                          "(served by TrajectoryPlannerROS with dwa: true)");
   for (const auto& [key, value, known] : {std::make_tuple("base_global_planner", c.global_type, &kGlobalPlanners),
                                           std::make_tuple("base_local_planner", c.local_type, &kLocalPlanners)}) {
     if (known->count(value)) continue;
@@ -67,14 +93,16 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
   // Global planner: navfn's keys (NavfnROS) or global_planner's (GlobalPlanner: use_dijkstra).
   const ParamValue* gv = r.values().get(c.global_ns);
   ParamReader g(gv ? *gv : ParamValue::ofMap(), r.where(c.global_ns), warn);
-  c.planner.use_astar = c.global_ns == "GlobalPlanner" ? !g.boolean("use_dijkstra", true)
-                                                       : g.boolean("use_astar", false);  // ours; navfn is Dijkstra only
-  c.planner.allow_unknown = g.boolean("allow_unknown", true);
-  c.planner.default_tolerance = g.number("default_tolerance", 0.0, 0.0);
+  c.planner.use_astar = c.global_ns == "GlobalPlanner"
+                            ? !g.boolean("use_dijkstra", !c.planner.use_astar, "GlobalPlanner: Dijkstra (true) or A* (false)")
+                            : g.boolean("use_astar", c.planner.use_astar, "ours: A* instead of navfn's Dijkstra");
+  c.planner.allow_unknown = g.boolean("allow_unknown", c.planner.allow_unknown, "plans may cross unknown cells");
+  c.planner.default_tolerance = g.number("default_tolerance", c.planner.default_tolerance,
+                                         "[m] plan to the nearest free cell within this of a blocked goal", 0.0);
   for (const char* key : {"visualize_potential", "planner_window_x", "planner_window_y", "planner_costmap_publish_frequency",
                           "use_quadratic", "use_grid_path", "old_navfn_behavior", "lethal_cost", "neutral_cost", "cost_factor",
                           "publish_potential", "orientation_mode", "orientation_window_size", "outline_map"}) {
-    g.raw(key);
+    g.ignored(key, "a key of navfn or global_planner that this planner does not need");
   }
   g.reportUnknown();
 
@@ -91,7 +119,7 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
   // Recoveries.
   std::vector<RecoveryConfig> out;
   if (r.has("recovery_behaviors")) {
-    const ParamValue spec = r.raw("recovery_behaviors");
+    const ParamValue spec = r.raw("recovery_behaviors", ParamValue::ofList(), kRecoveriesDoc, "list");
     bool ok = spec.type == ParamValue::Type::kList;
     for (const auto& b : spec.items) {
       const ParamValue* n = b.get("name");
@@ -113,6 +141,7 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
       out.push_back(rc);
     }
   } else {
+    r.raw("recovery_behaviors", ParamValue::ofList(), kRecoveriesDoc, "list");
     const std::vector<std::pair<std::string, int>> defaults = {
         {"conservative_reset", 0}, {"rotate_recovery", 1}, {"back_up", 2}, {"aggressive_reset", 0}, {"rotate_recovery", 1}};
     for (const auto& [name, type] : defaults) {
@@ -135,27 +164,33 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
       const double fallback = rc.name == "conservative_reset" && !r.has("recovery_behaviors") ? c.conservative_reset_dist
                               : rc.name == "aggressive_reset" && !r.has("recovery_behaviors") ? 4.0 * circumscribed_radius
                                                                                               : 3.0;
-      rc.reset_distance = pr.number("reset_distance", fallback, 0.0);
-      const ParamValue names = pr.raw("layer_names");
+      rc.reset_distance = pr.number("reset_distance", fallback,
+                                    "[m] obstacles within this square around the robot are kept, the rest cleared", 0.0);
+      ParamValue default_names = ParamValue::ofList();
+      for (const auto& n : rc.layer_names) default_names.items.push_back(ParamValue::ofString(n));
+      const ParamValue names = pr.raw("layer_names", default_names, "the layers cleared", "list");
       if (names.type == ParamValue::Type::kList) {
         rc.layer_names.clear();
         for (const auto& n : names.items) {
           if (n.type == ParamValue::Type::kString) rc.layer_names.push_back(n.s);
         }
       }
-      rc.affected_maps = pr.string("affected_maps", "both");
-      rc.force_updating = pr.boolean("force_updating", false);
-      rc.invert_area_to_clear = pr.boolean("invert_area_to_clear", false);
+      rc.affected_maps = pr.string("affected_maps", rc.affected_maps, "which costmaps: local, global or both");
+      rc.force_updating = pr.boolean("force_updating", rc.force_updating, "update the costmaps at once after clearing");
+      rc.invert_area_to_clear = pr.boolean("invert_area_to_clear", rc.invert_area_to_clear,
+                                           "clear inside the square instead of outside it");
       if (rc.affected_maps != "local" && rc.affected_maps != "global" && rc.affected_maps != "both") {
         throw ParamError("parameter " + pr.where("affected_maps") + " must be local, global or both");
       }
     } else if (rc.kind == RecoveryKind::kRotate) {
-      rc.sim_granularity = pr.number("sim_granularity", 0.017, std::nullopt, true);
-      rc.frequency = pr.number("frequency", 20.0, std::nullopt, true);
+      rc.sim_granularity = pr.number("sim_granularity", rc.sim_granularity,
+                                     "[rad] step between collision checks of the turn", std::nullopt, true);
+      rc.frequency = pr.number("frequency", rc.frequency, "[Hz] how often the turn command is sent", std::nullopt, true);
     } else {
-      rc.distance = pr.number("back_up_distance", 0.3, std::nullopt, true);
-      rc.speed = pr.number("back_up_speed", std::abs(c.local.escape_vel) > 0 ? std::abs(c.local.escape_vel) : 0.1, std::nullopt, true);
-      rc.frequency = pr.number("frequency", 20.0, std::nullopt, true);
+      rc.distance = pr.number("back_up_distance", rc.distance, "[m] how far to back up", std::nullopt, true);
+      rc.speed = pr.number("back_up_speed", std::abs(c.local.escape_vel) > 0 ? std::abs(c.local.escape_vel) : rc.speed,
+                           "[m/s] backing-up speed (default: the local planner's |escape_vel|)", std::nullopt, true);
+      rc.frequency = pr.number("frequency", rc.frequency, "[Hz] how often the command is sent", std::nullopt, true);
     }
     pr.reportUnknown();
   }

@@ -142,14 +142,71 @@ ParamReader::ParamReader(const ParamValue& values, const std::string& ns, Warn w
 
 std::string ParamReader::where(const std::string& key) const { return ns_ == "/" ? "/" + key : ns_ + "/" + key; }
 
-ParamValue ParamReader::raw(const std::string& key, const ParamValue& fallback) {
+namespace {
+thread_local ParamCatalog* t_catalog = nullptr;
+}  // namespace
+
+ParamCatalog::ParamCatalog() {
+  if (t_catalog) throw std::logic_error("ParamCatalog: one is already recording on this thread");
+  t_catalog = this;
+}
+ParamCatalog::~ParamCatalog() { close(); }
+void ParamCatalog::close() {
+  if (t_catalog == this) t_catalog = nullptr;
+}
+ParamCatalog* ParamCatalog::current() { return t_catalog; }
+
+void ParamCatalog::add(ParamDeclaration d) {
+  for (const auto& e : declarations_) {
+    if (e.ns == d.ns && e.key == d.key) return;
+  }
+  declarations_.push_back(std::move(d));
+}
+
+void ParamReader::declare(const std::string& key, const char* type, const ParamValue& fallback, const char* doc,
+                          const std::string& bounds) {
+  ParamCatalog* catalog = ParamCatalog::current();
+  if (!catalog) return;
+  ParamDeclaration d;
+  d.ns = ns_;
+  d.key = key;
+  d.type = type;
+  d.default_repr = fallback.repr();
+  d.bounds = bounds;
+  std::string text = doc ? doc : "";
+  if (text.size() > 1 && text[0] == '[') {
+    const auto close = text.find(']');
+    if (close != std::string::npos) {
+      d.unit = text.substr(1, close - 1);
+      text = text.substr(close + 1);
+      text.erase(0, text.find_first_not_of(' ') == std::string::npos ? text.size() : text.find_first_not_of(' '));
+    }
+  }
+  d.meaning = text;
+  catalog->add(std::move(d));
+}
+
+ParamValue ParamReader::lookup(const std::string& key, const ParamValue& fallback) {
   read_.insert(key);
   const ParamValue* v = values_.get(key);
   return v ? *v : fallback;
 }
 
-double ParamReader::number(const std::string& key, double fallback, std::optional<double> minimum, bool positive) {
-  const ParamValue v = raw(key, ParamValue::ofDouble(fallback));
+ParamValue ParamReader::raw(const std::string& key, const ParamValue& fallback, const char* doc, const char* type) {
+  declare(key, type, fallback, doc);
+  return lookup(key, fallback);
+}
+
+void ParamReader::ignored(const std::string& key, const char* why) {
+  declare(key, "any", ParamValue(), (std::string("not used: ") + why).c_str());
+  lookup(key, ParamValue());
+}
+
+double ParamReader::number(const std::string& key, double fallback, const char* doc, std::optional<double> minimum,
+                           bool positive) {
+  declare(key, "double", ParamValue::ofDouble(fallback), doc,
+          positive ? "> 0" : minimum ? ">= " + formatG(*minimum) : "");
+  const ParamValue v = lookup(key, ParamValue::ofDouble(fallback));
   if (!v.isNumber()) throw ParamError("parameter " + where(key) + " must be a number, got " + v.repr());
   const double x = v.number();
   if (positive && !(x > 0.0)) throw ParamError("parameter " + where(key) + " must be positive, got " + formatG(x));
@@ -159,8 +216,9 @@ double ParamReader::number(const std::string& key, double fallback, std::optiona
   return x;
 }
 
-long ParamReader::integer(const std::string& key, long fallback, std::optional<long> minimum) {
-  const ParamValue v = raw(key, ParamValue::ofInt(fallback));
+long ParamReader::integer(const std::string& key, long fallback, const char* doc, std::optional<long> minimum) {
+  declare(key, "int", ParamValue::ofInt(fallback), doc, minimum ? ">= " + std::to_string(*minimum) : "");
+  const ParamValue v = lookup(key, ParamValue::ofInt(fallback));
   long x;
   if (v.type == ParamValue::Type::kInt) x = v.i;
   else if (v.type == ParamValue::Type::kDouble && std::floor(v.d) == v.d && std::isfinite(v.d)) x = static_cast<long>(v.d);
@@ -171,9 +229,11 @@ long ParamReader::integer(const std::string& key, long fallback, std::optional<l
   return x;
 }
 
-bool ParamReader::boolean(const std::string& key, bool fallback) {
-  const ParamValue v = raw(key, ParamValue::ofBool(fallback));
+bool ParamReader::boolean(const std::string& key, bool fallback, const char* doc) {
+  declare(key, "bool", ParamValue::ofBool(fallback), doc);
+  const ParamValue v = lookup(key, ParamValue::ofBool(fallback));
   if (v.type == ParamValue::Type::kBool) return v.b;
+  if (v.type == ParamValue::Type::kInt && (v.i == 0 || v.i == 1)) return v.i == 1;  // gmapping's YAMLs write 0 and 1
   if (v.type == ParamValue::Type::kString) {
     std::string lower = v.s;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -182,14 +242,18 @@ bool ParamReader::boolean(const std::string& key, bool fallback) {
   throw ParamError("parameter " + where(key) + " must be true or false, got " + v.repr());
 }
 
-std::string ParamReader::string(const std::string& key, const std::string& fallback) {
-  const ParamValue v = raw(key, ParamValue::ofString(fallback));
+std::string ParamReader::string(const std::string& key, const std::string& fallback, const char* doc) {
+  declare(key, "string", ParamValue::ofString(fallback), doc);
+  const ParamValue v = lookup(key, ParamValue::ofString(fallback));
   if (v.type != ParamValue::Type::kString) throw ParamError("parameter " + where(key) + " must be a string, got " + v.repr());
   return v.s;
 }
 
-std::string ParamReader::frame(const std::string& key, const std::string& fallback) {
-  std::string value = string(key, fallback);
+std::string ParamReader::frame(const std::string& key, const std::string& fallback, const char* doc) {
+  declare(key, "frame", ParamValue::ofString(fallback), doc);
+  const ParamValue v = lookup(key, ParamValue::ofString(fallback));
+  if (v.type != ParamValue::Type::kString) throw ParamError("parameter " + where(key) + " must be a string, got " + v.repr());
+  std::string value = v.s;
   if (!value.empty() && value[0] == '/') {
     const std::string stripped = value.substr(value.find_first_not_of('/') == std::string::npos ? value.size()
                                                                                                 : value.find_first_not_of('/'));
@@ -201,19 +265,21 @@ std::string ParamReader::frame(const std::string& key, const std::string& fallba
   return value;
 }
 
-double ParamReader::deprecated(const std::string& new_key, const std::string& old_key, double fallback) {
+double ParamReader::deprecated(const std::string& new_key, const std::string& old_key, double fallback, const char* doc) {
+  declare(new_key, "double", ParamValue::ofDouble(fallback), doc);
+  declare(old_key, "double", ParamValue(), ("deprecated name of " + new_key).c_str());
   if (has(new_key)) {
     if (has(old_key)) {
       read_.insert(old_key);
       warn("parameter " + where(old_key) + " is ignored because " + where(new_key) + " is set");
     }
-    return number(new_key, fallback);
+    return number(new_key, fallback, doc);
   }
   if (has(old_key)) {
     warn("parameter " + where(old_key) + " is deprecated; use " + new_key);
-    return number(old_key, fallback);
+    return number(old_key, fallback, doc);
   }
-  return number(new_key, fallback);
+  return number(new_key, fallback, doc);
 }
 
 std::vector<std::string> ParamReader::reportUnknown(const std::set<std::string>& skip,

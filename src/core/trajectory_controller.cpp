@@ -24,9 +24,10 @@ void readLocalPlannerParams(const ParamValue& values, const std::string& ns, con
   const Warn warn = orIgnore(warn_or_empty);
   ParamReader r(values, ns, warn);
   p = LocalPlannerParams();
-  p.acc_lim_x = r.number("acc_lim_x", 2.5, 0.0);
-  p.acc_lim_y = r.number("acc_lim_y", 2.5, 0.0);
-  p.acc_lim_theta = r.deprecated("acc_lim_theta", "acc_lim_th", 3.2);
+  ros = LocalPlannerRosParams();
+  p.acc_lim_x = r.number("acc_lim_x", p.acc_lim_x, "[m/s^2] forward acceleration limit", 0.0);
+  p.acc_lim_y = r.number("acc_lim_y", p.acc_lim_y, "[m/s^2] sideways acceleration limit (holonomic robots)", 0.0);
+  p.acc_lim_theta = r.deprecated("acc_lim_theta", "acc_lim_th", p.acc_lim_theta, "[rad/s^2] rotational acceleration limit");
   for (const char* wrong : {"acc_limit_x", "acc_limit_y", "acc_limit_th"}) {
     if (!r.has(wrong)) continue;
     r.markRead(wrong);
@@ -34,61 +35,75 @@ void readLocalPlannerParams(const ParamValue& values, const std::string& ns, con
     right.replace(0, 9, "acc_lim");
     warn("parameter " + r.where(wrong) + " is not read; the name is " + right + " (the old documentation was wrong)");
   }
-  p.max_vel_x = r.number("max_vel_x", 0.55, 0.0);
-  p.min_vel_x = r.number("min_vel_x", 0.0, 0.0);
+  p.max_vel_x = r.number("max_vel_x", p.max_vel_x, "[m/s] fastest forward speed", 0.0);
+  p.min_vel_x = r.number("min_vel_x", p.min_vel_x, "[m/s] slowest forward speed sampled", 0.0);
   if (r.has("max_rotational_vel")) {
     // ROS reads it at start-up, then dynamic_reconfigure overwrites it with max/min_vel_theta.
-    r.markRead("max_rotational_vel");
     warn("parameter " + r.where("max_rotational_vel") +
          " has no effect in TrajectoryPlannerROS (dynamic_reconfigure replaces it with max_vel_theta / min_vel_theta); "
          "rotate_recovery still reads it");
   }
-  p.max_vel_theta = r.number("max_vel_theta", 1.0, 0.0);
-  p.min_vel_theta = r.number("min_vel_theta", -1.0);
+  ros.max_rotational_vel = r.number("max_rotational_vel", ros.max_rotational_vel,
+                                    "[rad/s] fastest turn of rotate_recovery (the planner uses max_vel_theta)");
+  p.max_vel_theta = r.number("max_vel_theta", p.max_vel_theta, "[rad/s] fastest counter-clockwise turn", 0.0);
+  p.min_vel_theta = r.number("min_vel_theta", p.min_vel_theta, "[rad/s] fastest clockwise turn (<= 0)");
   if (p.min_vel_theta > 0) {
     throw ParamError("parameter " + r.where("min_vel_theta") + " must be <= 0 (it is the fastest clockwise turn), got " +
                      g(p.min_vel_theta));
   }
-  p.min_in_place_vel_theta = r.deprecated("min_in_place_vel_theta", "min_in_place_rotational_vel", 0.4);
-  double backup = -0.1;
+  p.min_in_place_vel_theta = r.deprecated("min_in_place_vel_theta", "min_in_place_rotational_vel", p.min_in_place_vel_theta,
+                                          "[rad/s] slowest turn on the spot");
+  double backup = p.escape_vel;
   if (r.has("backup_vel")) {
     warn("parameter " + r.where("backup_vel") + " is deprecated; use escape_vel");
-    backup = r.number("backup_vel", -0.1);
+    backup = r.number("backup_vel", backup, "[m/s] deprecated name of escape_vel");
   }
-  p.escape_vel = r.number("escape_vel", backup);
+  p.escape_vel = r.number("escape_vel", backup, "[m/s] speed when backing out of a dead end (< 0: backwards)");
   if (p.escape_vel >= 0) {
     warn("parameter " + r.where("escape_vel") + " is " + g(p.escape_vel) +
          ": a non-negative escape velocity moves the robot forward when it should back up");
   }
-  p.sim_time = r.number("sim_time", 1.7, std::nullopt, true);
-  p.sim_granularity = r.number("sim_granularity", 0.025, std::nullopt, true);
-  p.angular_sim_granularity = r.number("angular_sim_granularity", 0.025, std::nullopt, true);
-  p.vx_samples = static_cast<int>(r.integer("vx_samples", 20));
-  p.vtheta_samples = static_cast<int>(r.integer("vtheta_samples", 20));
+  p.sim_time = r.number("sim_time", p.sim_time, "[s] how far ahead each sampled trajectory is simulated", std::nullopt, true);
+  p.sim_granularity = r.number("sim_granularity", p.sim_granularity, "[m] step between collision checks along a trajectory",
+                               std::nullopt, true);
+  p.angular_sim_granularity = r.number("angular_sim_granularity", p.angular_sim_granularity,
+                                       "[rad] rotational step between collision checks", std::nullopt, true);
+  p.vx_samples = static_cast<int>(r.integer("vx_samples", p.vx_samples, "forward speeds sampled"));
+  p.vtheta_samples = static_cast<int>(r.integer("vtheta_samples", p.vtheta_samples, "turn rates sampled"));
   for (auto [key, value] : {std::make_pair("vx_samples", &p.vx_samples), std::make_pair("vtheta_samples", &p.vtheta_samples)}) {
     if (*value < 1) {
       warn("parameter " + r.where(key) + " is " + std::to_string(*value) + "; at least one sample is taken");
       *value = 1;
     }
   }
-  p.path_distance_bias = r.deprecated("path_distance_bias", "pdist_scale", 0.6);
-  p.goal_distance_bias = r.deprecated("goal_distance_bias", "gdist_scale", 0.8);
-  p.occdist_scale = r.number("occdist_scale", 0.01, 0.0);
+  p.path_distance_bias = r.deprecated("path_distance_bias", "pdist_scale", p.path_distance_bias,
+                                      "weight of staying near the global path");
+  p.goal_distance_bias = r.deprecated("goal_distance_bias", "gdist_scale", p.goal_distance_bias,
+                                      "weight of getting nearer to the local goal");
+  p.occdist_scale = r.number("occdist_scale", p.occdist_scale, "weight of keeping away from obstacles (the highest cost met)",
+                             0.0);
   if (!r.has("meter_scoring")) {
     warn("parameter " + r.where("meter_scoring") +
          " is not set: the distance biases count cells, so the behaviour changes with the costmap resolution; set it to true");
   }
-  p.meter_scoring = r.boolean("meter_scoring", false);
-  p.heading_lookahead = r.number("heading_lookahead", 0.325, 0.0);
-  p.heading_scoring = r.boolean("heading_scoring", false);
-  p.heading_scoring_timestep = r.number("heading_scoring_timestep", 0.1, 0.0);
-  p.oscillation_reset_dist = r.number("oscillation_reset_dist", 0.05, 0.0);
-  p.escape_reset_dist = r.number("escape_reset_dist", 0.10, 0.0);
-  p.escape_reset_theta = r.number("escape_reset_theta", M_PI / 2, 0.0);
-  p.holonomic_robot = r.boolean("holonomic_robot", true);
-  p.dwa = r.boolean("dwa", false);
-  p.simple_attractor = r.boolean("simple_attractor", false);
-  const ParamValue y_vels = r.raw("y_vels", ParamValue::ofString("-0.3,-0.1,0.1,-0.3"));
+  p.meter_scoring = r.boolean("meter_scoring", p.meter_scoring,
+                              "distances in the cost in metres (true) or cells (false, ROS's default)");
+  p.heading_lookahead = r.number("heading_lookahead", p.heading_lookahead, "[m] how far ahead in-place turns are scored",
+                                 0.0);
+  p.heading_scoring = r.boolean("heading_scoring", p.heading_scoring, "score the heading to the path instead of distance");
+  p.heading_scoring_timestep = r.number("heading_scoring_timestep", p.heading_scoring_timestep,
+                                        "[s] how far along a trajectory its heading is scored", 0.0);
+  p.oscillation_reset_dist = r.number("oscillation_reset_dist", p.oscillation_reset_dist,
+                                      "[m] travel that clears the oscillation flags", 0.0);
+  p.escape_reset_dist = r.number("escape_reset_dist", p.escape_reset_dist, "[m] travel that ends escaping", 0.0);
+  p.escape_reset_theta = r.number("escape_reset_theta", p.escape_reset_theta, "[rad] turn that ends escaping", 0.0);
+  p.holonomic_robot = r.boolean("holonomic_robot", p.holonomic_robot, "sample sideways speeds (y_vels) too");
+  p.dwa = r.boolean("dwa", p.dwa, "sample only speeds reachable within one control period (Dynamic Window)");
+  p.simple_attractor = r.boolean("simple_attractor", p.simple_attractor,
+                                 "score by straight-line distance to the goal instead of the path grids");
+  const ParamValue y_vels = r.raw("y_vels", ParamValue::ofString("-0.3,-0.1,0.1,-0.3"),
+                                  "[m/s] sideways speeds sampled by a holonomic robot (list, or a comma-separated string)",
+                                  "list");
   p.y_vels.clear();
   bool ok = true;
   if (y_vels.type == ParamValue::Type::kString) {
@@ -107,20 +122,26 @@ void readLocalPlannerParams(const ParamValue& values, const std::string& ns, con
     ok = false;
   }
   if (!ok) throw ParamError("parameter " + r.where("y_vels") + " must be a list of speeds, got " + y_vels.repr());
-  double frequency = r.has("controller_frequency") ? r.number("controller_frequency", controller_frequency) : controller_frequency;
+  double frequency = r.has("controller_frequency")
+                         ? r.number("controller_frequency", controller_frequency,
+                                    "[Hz] the control rate the planner assumes (default: move_base's controller_frequency)")
+                         : controller_frequency;
   if (frequency <= 0) {
     warn("controller_frequency " + g(frequency) + " is not positive; the planner assumes 20 Hz");
     frequency = 20.0;
   }
   p.sim_period = 1.0 / frequency;
-  ros.xy_goal_tolerance = r.number("xy_goal_tolerance", 0.10, 0.0);
-  ros.yaw_goal_tolerance = r.number("yaw_goal_tolerance", 0.05, 0.0);
-  ros.latch_xy_goal_tolerance = r.boolean("latch_xy_goal_tolerance", false);
-  ros.prune_plan = r.boolean("prune_plan", true);
-  ros.stop_time_buffer = r.number("stop_time_buffer", 0.2, 0.0);
-  const ParamValue* mrv = r.values().get("max_rotational_vel");
-  ros.max_rotational_vel = mrv && mrv->isNumber() ? mrv->number() : 1.0;
-  for (const char* key : {"world_model", "restore_defaults", "point_grid", "x_goal_tolerance", "y_goal_tolerance"}) r.markRead(key);
+  ros.xy_goal_tolerance = r.number("xy_goal_tolerance", ros.xy_goal_tolerance, "[m] how near the goal counts as reached", 0.0);
+  ros.yaw_goal_tolerance = r.number("yaw_goal_tolerance", ros.yaw_goal_tolerance,
+                                    "[rad] how near the goal's heading counts as reached", 0.0);
+  ros.latch_xy_goal_tolerance = r.boolean("latch_xy_goal_tolerance", ros.latch_xy_goal_tolerance,
+                                          "once within xy_goal_tolerance, only turn in place to the goal's heading");
+  ros.prune_plan = r.boolean("prune_plan", ros.prune_plan, "drop the plan's points the robot has passed");
+  ros.stop_time_buffer = r.number("stop_time_buffer", ros.stop_time_buffer,
+                                  "[s] ROS's margin before a collision; read, not used by this planner", 0.0);
+  for (const char* key : {"world_model", "restore_defaults", "point_grid", "x_goal_tolerance", "y_goal_tolerance"}) {
+    r.ignored(key, "accepted as in ROS, where it has no effect or is superseded");
+  }
   r.reportUnknown();
 }
 

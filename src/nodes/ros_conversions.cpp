@@ -64,30 +64,6 @@ std::string describeScanProblem(const sensor_msgs::LaserScan& msg) {
   return why.str();
 }
 
-std::string nearestName(const std::string& name, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_d = std::string::npos;
-  for (const std::string& c : candidates) {
-    // Levenshtein distance, one row at a time.
-    std::vector<std::size_t> row(c.size() + 1);
-    for (std::size_t j = 0; j <= c.size(); ++j) row[j] = j;
-    for (std::size_t i = 1; i <= name.size(); ++i) {
-      std::size_t diag = row[0];
-      row[0] = i;
-      for (std::size_t j = 1; j <= c.size(); ++j) {
-        const std::size_t up = row[j];
-        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (name[i - 1] == c[j - 1] ? 0 : 1)});
-        diag = up;
-      }
-    }
-    if (row[c.size()] < best_d) {
-      best_d = row[c.size()];
-      best = c;
-    }
-  }
-  return best;
-}
-
 core::ParamValue fromXmlRpc(XmlRpc::XmlRpcValue& v) {
   using core::ParamValue;
   switch (v.getType()) {

@@ -54,9 +54,6 @@ class SeqGapCounter {
   uint64_t total_ = 0;
 };
 
-/// The candidate closest to `name` by edit distance (for "unknown parameter, did you mean" warnings).
-std::string nearestName(const std::string& name, const std::vector<std::string>& candidates);
-
 /// A parameter server value as the core's ParamValue (dates and binary become strings).
 core::ParamValue fromXmlRpc(XmlRpc::XmlRpcValue& value);
 

@@ -46,6 +46,7 @@
 #include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
+#include "mbot_slam_navigation/core/slam_config.h"
 #include "ros_conversions.h"
 #include "sim_rate.h"
 
@@ -64,7 +65,7 @@ class SlamGmappingNode {
   SlamGmappingNode() : pnh_("~"), tf_listener_(tf_buffer_) {
     try {
       readParameters();
-    } catch (const std::invalid_argument& e) {
+    } catch (const mbot::core::ParamError& e) {
       // Logged here: once this node's handles are gone, roscpp has shut rosconsole down.
       ROS_FATAL("slam_gmapping: %s", e.what());
       throw;
@@ -88,127 +89,26 @@ class SlamGmappingNode {
   }
 
  private:
-  template <typename T>
-  void param(const std::string& name, T& value) {
-    known_.push_back(name);
-    pnh_.param(name, value, value);
-  }
-
   void readParameters() {
-    param("base_frame", base_frame_);
-    param("odom_frame", odom_frame_);
-    param("map_frame", map_frame_);
-    param("map_update_interval", map_update_interval_);
-    param("transform_publish_period", transform_publish_period_);
-    param("occ_thresh", occ_thresh_);
-    param("throttle_scans", throttle_scans_);
-    param("tf_delay", tf_delay_);
-    param("correction_threshold", correction_threshold_);
-    param("scan_queue_size", scan_queue_size_);
-    if (scan_queue_size_ < 1) {
-      throw std::invalid_argument("~scan_queue_size must be at least 1 (scans held while the node is busy), got " +
-                                  std::to_string(scan_queue_size_));
-    }
-    auto& p = params_;
-    auto& m = p.matcher;
-    double max_urange = -1.0, max_range = -1.0;  // default: the scan's range_max, as gmapping
-    param("maxUrange", max_urange);
-    param("maxRange", max_range);
-    m.max_urange = max_urange;
-    m.max_range = max_range;
-    param("sigma", m.sigma);
-    param("kernelSize", m.kernel_size);
-    param("lstep", m.lstep);
-    param("astep", m.astep);
-    param("iterations", m.iterations);
-    param("lsigma", m.lsigma);
-    param("ogain", p.ogain);
-    param("lskip", m.lskip);
-    param("minimumScore", p.minimum_score);
-    // The motion noise defaults to the odometry the filter moves with: gmapping's for the wheels,
-    // a tenth of it for the scan-matched track (rbpf_slam.h).
-    param("scan_odometry", p.scan_odometry);
-    if (p.scan_odometry) p.motion = mbot::core::scanOdometryMotion();
-    param("srr", p.motion.srr);
-    param("srt", p.motion.srt);
-    param("str", p.motion.str);
-    param("stt", p.motion.stt);
-    param("linearUpdate", p.linear_update);
-    param("angularUpdate", p.angular_update);
-    param("temporalUpdate", p.temporal_update);
-    param("resampleThreshold", p.resample_threshold);
-    param("particles", p.particles);
-    param("xmin", p.xmin);
-    param("ymin", p.ymin);
-    param("xmax", p.xmax);
-    param("ymax", p.ymax);
-    param("delta", p.delta);
-    param("llsamplerange", p.llsamplerange);
-    param("llsamplestep", p.llsamplestep);
-    param("lasamplerange", p.lasamplerange);
-    param("lasamplestep", p.lasamplestep);
-    int seed = 0;
-    param("seed", seed);
-    p.seed = static_cast<unsigned>(seed);
-    param("threads", p.threads);
-    param("best_switch_margin", p.best_switch_margin);
-    param("backend", backend_);
-    if (backend_ != "graph" && backend_ != "rbpf") {
-      throw std::invalid_argument("~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got '" + backend_ + "'");
-    }
-    auto& g = graph_params_;
-    param("match_max_range", g.match_max_range);
-    param("match_sigma", g.match_sigma);
-    param("local_match_sigma", g.local_match_sigma);
-    param("local_map_nodes", g.local_map_nodes);
-    param("local_search_window", g.local_search_window);
-    param("local_search_sigmas", g.local_search_sigmas);
-    param("local_search_max_window", g.local_search_max_window);
-    param("local_search_angle", g.local_search_angle);
-    param("local_min_score", g.local_min_score);
-    param("local_prior_margin", g.local_prior_margin);
-    param("local_prior_weight", g.local_prior_weight);
-    param("local_prior_points", g.local_prior_points);
-    param("local_visible_only", g.local_visible_only);
-    param("local_visible_side", g.local_visible_side);
-    param("submap_nodes", g.submap_nodes);
-    param("loop_search_radius", g.loop_search_radius);
-    param("loop_search_growth", g.loop_search_growth);
-    param("loop_search_max_radius", g.loop_search_max_radius);
-    param("loop_search_reach", g.loop_search_reach);
-    param("loop_search_angle", g.loop_search_angle);
-    param("loop_min_response", g.loop_min_response);
-    param("loop_ambiguity", g.loop_ambiguity);
-    param("loop_sigma_distance", g.loop_sigma_distance);
-    param("loop_visible_shift", g.loop_visible_shift);
-    param("loop_candidates", g.loop_candidates);
-    param("loop_recent_submap", g.loop_recent_submap);
-    param("redundant_distance", g.redundant_distance);
-    param("redundant_angle", g.redundant_angle);
-    param("keep_trimmed_scans", g.keep_trimmed_scans);
-    param("loop_solve_chi2", g.loop_solve_chi2);
-    g.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
-    // The parameters both backends share have gmapping's names; read once above and given to the
-    // graph (or the rbpf's track) by RbpfParams::shareWith when the backend is made.
-    // The graph's own default (graph_slam.h: a node every 0.5 m) unless the user set linearUpdate.
-    if (pnh_.hasParam("linearUpdate")) g.linear_update = p.linear_update;
-    for (std::string* frame : {&base_frame_, &odom_frame_, &map_frame_}) {
-      if (!frame->empty() && (*frame)[0] == '/') {
-        ROS_WARN("slam_gmapping: frame '%s' has a leading '/', which tf2 rejects; using '%s'", frame->c_str(),
-                 frame->substr(1).c_str());
-        *frame = frame->substr(1);
-      }
-    }
-    std::vector<std::string> names;
-    pnh_.getParamNames(names);
-    const std::string prefix = pnh_.getNamespace() + "/";
-    for (const std::string& full : names) {
-      if (full.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string key = full.substr(prefix.size());
-      if (key.find('/') != std::string::npos || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
-      ROS_WARN("slam_gmapping: unknown parameter ~%s is ignored; did you mean ~%s?", key.c_str(),
-               mbot::ros_glue::nearestName(key, known_).c_str());
-    }
+    XmlRpc::XmlRpcValue values;
+    if (!pnh_.getParam("", values)) values = XmlRpc::XmlRpcValue();
+    const auto c = mbot::core::readSlamConfig(mbot::ros_glue::fromXmlRpc(values), pnh_.getNamespace(),
+                                              [](const std::string& text) { ROS_WARN("slam_gmapping: %s", text.c_str()); },
+                                              -1.0);
+    base_frame_ = c.base_frame;
+    odom_frame_ = c.odom_frame;
+    map_frame_ = c.map_frame;
+    map_update_interval_ = c.map_update_interval;
+    transform_publish_period_ = c.transform_publish_period;
+    occ_thresh_ = c.occ_thresh;
+    throttle_scans_ = c.throttle_scans;
+    tf_delay_ = c.tf_delay;
+    correction_threshold_ = c.correction_threshold;
+    scan_queue_size_ = c.scan_queue_size;
+    backend_ = c.backend;
+    params_ = c.rbpf;
+    graph_params_ = c.graph;
+    graph_params_.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg) {
@@ -492,14 +392,14 @@ class SlamGmappingNode {
   }
 
   ros::NodeHandle nh_, pnh_;
-  std::vector<std::string> known_;
-  std::string base_frame_ = "base_link", odom_frame_ = "odom", map_frame_ = "map";
-  double map_update_interval_ = 5.0, transform_publish_period_ = 0.05, occ_thresh_ = 0.25, tf_delay_ = -1.0;
+  // From ~ (core/slam_config.h, where their defaults and meanings are).
+  std::string base_frame_, odom_frame_, map_frame_;
+  double map_update_interval_ = 0.0, transform_publish_period_ = 0.0, occ_thresh_ = 0.0, tf_delay_ = 0.0;
   int throttle_scans_ = 1;
-  int scan_queue_size_ = kDefaultScanQueue;
+  int scan_queue_size_ = 1;
   mbot::core::RbpfParams params_;
   mbot::core::GraphSlamParams graph_params_;
-  std::string backend_ = "graph";
+  std::string backend_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
@@ -512,14 +412,11 @@ class SlamGmappingNode {
   static constexpr std::size_t kTrimFreeBytes = 64u << 20;  // free heap [bytes] given back at once
   static constexpr double kTrimPeriod = 60.0;                 // [s] between trims otherwise
   static constexpr double kMaxScanTransformAge = 5.0;  // [s]
-  // Scans held while the node is busy: gmapping's 5 dropped scans at every particle-filter update
-  // of a bag played at 10x (FR079: 700-1000 of 4934), so that each run processed other scans.
-  static constexpr int kDefaultScanQueue = 100;  // scans
   std::mutex stamp_mutex_;
   std::deque<ros::Time> loop_stamps_, scan_stamps_;
   ros::Time last_scan_tf_stamp_;
   bool first_transform_ = true;
-  double correction_threshold_ = 0.1;
+  double correction_threshold_ = 0.0;
   std::unique_ptr<mbot::core::SlamBackend> slam_;  // replaced in the scan callback only
   Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
   nav_msgs::OccupancyGrid::ConstPtr last_map_;  // as published; never changed after
@@ -539,7 +436,7 @@ int main(int argc, char** argv) {
   try {
     SlamGmappingNode node;
     ros::spin();
-  } catch (const std::invalid_argument&) {
+  } catch (const mbot::core::ParamError&) {
     return 1;  // already logged
   }
   return 0;

@@ -118,8 +118,8 @@ class SlamHomeTest(unittest.TestCase):
             return False
 
         try:
-            self.assertTrue(printed('~base_link'), 'no warning about ~base_link: %s' % ''.join(lines))
-            self.assertIn('did you mean ~base_frame', next(l for l in lines if '~base_link' in l))
+            self.assertTrue(printed('/base_link'), 'no warning about ~base_link: %s' % ''.join(lines))
+            self.assertIn('did you mean base_frame?', next(l for l in lines if '/base_link' in l))
             static = tf2_ros.StaticTransformBroadcaster()
             tfs = []
             for parent, child in (('tc_odom', 'tc_base'), ('tc_base', 'tc_laser')):

@@ -165,14 +165,15 @@ def test_slam_offline_names_an_unknown_parameter_of_the_backend(tmp_path, capsys
     with pytest.raises(SystemExit):
         main([os.path.join(DATA, 'tiny.clf'), '-o', str(tmp_path / 'x'), '--quiet', '--backend', 'graph',
               '--param', 'loop_min_respons=0.5'])
-    assert 'did you mean "loop_min_response"' in capsys.readouterr().err
+    assert 'did you mean loop_min_response?' in capsys.readouterr().err
 
 
 def test_graph_parameters_reach_the_core_and_bad_ones_are_refused():
-    from mbot_slam_navigation.slam.backends import GRAPH_DEFAULTS, make_graph_params
+    from mbot_slam_navigation import _core
+    from mbot_slam_navigation.slam.backends import make_graph_params
     p = make_graph_params({'submap_nodes': 7, 'loop_min_response': 0.6, 'linearUpdate': 0.3})
     assert (p.submap_nodes, p.loop_min_response, p.linear_update) == (7, 0.6, 0.3)
-    assert p.match_sigma == GRAPH_DEFAULTS['match_sigma'] and not p.background
+    assert p.match_sigma == _core._GraphSlamParams().match_sigma and not p.background
     with pytest.raises(ValueError, match='loop_min_response'):
         make_graph_params({'loop_min_response': 2.0})
     with pytest.raises(ValueError, match='local_search_max_window'):
@@ -208,26 +209,20 @@ def test_the_graph_lists_its_chain_edges_as_the_relative_poses_of_its_nodes():
     assert slam.closures() == []
 
 
-def test_graph_defaults_in_python_are_the_cores():
-    # Declared twice (graph_slam.h for the node, backends.py for slam_offline and the benches):
-    # a default changed in one place only would make offline figures of another configuration.
+def test_offline_runs_read_the_nodes_parameters_with_the_nodes_defaults():
+    """slam_offline and the node read one declaration (core/slam_config.h): the same defaults,
+    except maxUrange and maxRange, which a log cannot take from its scans."""
     from mbot_slam_navigation import _core
-    from mbot_slam_navigation.slam.backends import COMMON_DEFAULTS, GRAPH_DEFAULTS
-    core = _core._GraphSlamParams()
-    for key, value in GRAPH_DEFAULTS.items():
-        if key not in COMMON_DEFAULTS:
-            assert getattr(core, key) == pytest.approx(value), key
-
-
-def test_rbpf_defaults_in_python_are_the_cores():
-    # The same for the particle filter's own values that the core declares under the same name.
-    from mbot_slam_navigation import _core
-    from mbot_slam_navigation.slam.backends import GMAPPING_DEFAULTS
-    core = _core._RbpfParams()
-    for key in ('particles', 'ogain', 'llsamplerange', 'llsamplestep', 'lasamplerange', 'lasamplestep', 'seed',
-                'threads', 'best_switch_margin'):
-        assert getattr(core, key) == pytest.approx(GMAPPING_DEFAULTS[key]), key
-    assert core.scan_odometry == bool(GMAPPING_DEFAULTS['scan_odometry'])
+    from mbot_slam_navigation.slam.backends import OFFLINE_MAX_RANGE, make_graph_params, make_params
+    node, unknown = _core.read_slam_config({}, '/slam_gmapping', None, -1.0)
+    assert unknown == [] and node.rbpf.matcher.max_urange == -1.0
+    g, p = make_graph_params({}), make_params({})
+    assert g.matcher.max_urange == OFFLINE_MAX_RANGE and p.matcher.max_range == OFFLINE_MAX_RANGE
+    for key in ('local_map_nodes', 'local_prior_points', 'loop_min_response', 'submap_nodes', 'linear_update'):
+        assert getattr(g, key) == pytest.approx(getattr(node.graph, key)), key
+    for key in ('particles', 'ogain', 'best_switch_margin', 'linear_update', 'resample_threshold'):
+        assert getattr(p, key) == pytest.approx(getattr(node.rbpf, key)), key
+    assert (g.linear_update, p.linear_update) == (0.5, 1.0)  # a node every 0.5 m; gmapping's 1 m
 
 
 def test_a_carmen_log_becomes_a_bag_that_slam_can_play(tmp_path):

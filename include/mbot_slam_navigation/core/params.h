@@ -7,6 +7,11 @@
 // namespace it belongs to when it is a known key of another one (`planner_frequency` in
 // `local_costmap`). Wrong types name the key and its namespace (ParamError). Frame ids lose a
 // leading `/` (tf2 rejects them) with one warning each. Warnings go to a callable.
+//
+// Each read carries the parameter's one line of meaning, its unit first in brackets
+// ("[m/s] the fastest forward speed"); with a ParamCatalog alive, every reader records what it
+// reads (key, type, default, bounds, unit, meaning): the generated reference pages (docs/nodes/)
+// come from there, so a parameter's default and meaning are written once, in the call that reads it.
 #pragma once
 
 #include <functional>
@@ -52,6 +57,36 @@ class ParamError : public std::runtime_error {
 
 using Warn = std::function<void(const std::string&)>;
 
+/// One parameter as a reader read it, for the reference pages.
+struct ParamDeclaration {
+  std::string ns;            ///< the reader's namespace, e.g. /move_base/local_costmap
+  std::string key;
+  std::string type;          ///< double, int, bool, string, frame, list, any
+  std::string default_repr;  ///< Python-like, as ParamValue::repr
+  std::string bounds;        ///< "> 0", ">= 0.5" or ""
+  std::string unit;          ///< from the doc's leading "[unit]", or ""
+  std::string meaning;       ///< the doc without its unit; "" when the read gave none
+};
+
+/// While one is alive, every ParamReader on this thread records its reads in it (the first read of
+/// a namespace's key wins). Not nestable: a second one on the same thread throws std::logic_error.
+class ParamCatalog {
+ public:
+  ParamCatalog();
+  ~ParamCatalog();
+  ParamCatalog(const ParamCatalog&) = delete;
+  ParamCatalog& operator=(const ParamCatalog&) = delete;
+  const std::vector<ParamDeclaration>& declarations() const { return declarations_; }
+  /// The catalog alive on this thread, or nullptr.
+  static ParamCatalog* current();
+  void add(ParamDeclaration d);
+  /// Stops recording (the declarations stay); the destructor does it too.
+  void close();
+
+ private:
+  std::vector<ParamDeclaration> declarations_;
+};
+
 /// `warn`, or a callable that drops the text when `warn` is empty.
 inline Warn orIgnore(const Warn& warn) {
   return warn ? warn : Warn([](const std::string&) {});
@@ -70,17 +105,23 @@ class ParamReader {
   const std::string& ns() const { return ns_; }
   std::string where(const std::string& key) const;
   bool has(const std::string& key) const { return values_.get(key) != nullptr; }
-  /// The value (marking the key read), or `fallback` when it is not set.
-  ParamValue raw(const std::string& key, const ParamValue& fallback = ParamValue());
-  double number(const std::string& key, double fallback, std::optional<double> minimum = std::nullopt, bool positive = false);
-  long integer(const std::string& key, long fallback, std::optional<long> minimum = std::nullopt);
-  bool boolean(const std::string& key, bool fallback);
-  std::string string(const std::string& key, const std::string& fallback);
+  // `doc`: one line of meaning, the unit first in brackets: "[Hz] how often the loop runs".
+  /// The value (marking the key read), or `fallback` when it is not set; `type` names what the
+  /// caller accepts, for the reference pages.
+  ParamValue raw(const std::string& key, const ParamValue& fallback, const char* doc, const char* type = "any");
+  double number(const std::string& key, double fallback, const char* doc, std::optional<double> minimum = std::nullopt,
+                bool positive = false);
+  long integer(const std::string& key, long fallback, const char* doc, std::optional<long> minimum = std::nullopt);
+  bool boolean(const std::string& key, bool fallback, const char* doc);
+  std::string string(const std::string& key, const std::string& fallback, const char* doc);
   /// A frame id; a leading '/' is stripped with a warning; empty is an error.
-  std::string frame(const std::string& key, const std::string& fallback);
+  std::string frame(const std::string& key, const std::string& fallback, const char* doc);
+  /// A key accepted for compatibility with the ROS tool and not used: read (so that it is not
+  /// reported unknown) and listed on the reference page with `why`.
+  void ignored(const std::string& key, const char* why);
   /// ROS's loadParameterWithDeprecation for numbers: the new name wins; the old one still works,
   /// with a warning.
-  double deprecated(const std::string& new_key, const std::string& old_key, double fallback);
+  double deprecated(const std::string& new_key, const std::string& old_key, double fallback, const char* doc);
   /// Warns about every key set but never read, except `skip` (sub-namespaces handled elsewhere);
   /// `elsewhere` maps keys of other namespaces to where they belong. Returns the unknown keys.
   std::vector<std::string> reportUnknown(const std::set<std::string>& skip = {},
@@ -94,6 +135,10 @@ class ParamReader {
   }
 
  private:
+  ParamValue lookup(const std::string& key, const ParamValue& fallback);
+  void declare(const std::string& key, const char* type, const ParamValue& fallback, const char* doc,
+               const std::string& bounds = "");
+
   ParamValue values_;
   std::string ns_;
   Warn warn_;

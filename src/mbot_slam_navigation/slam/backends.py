@@ -4,108 +4,47 @@
 current_pose, trajectory, occupancy and updates (core/slam_backend.h). Poses are the base in the
 map frame (x [m], y [m], yaw [rad]).
 """
-import difflib
 from typing import Dict, Tuple
 
 import numpy as np
 
 from mbot_slam_navigation import _core
 
-# The parameters both backends read (slam_gmapping's names and ROS defaults).
-COMMON_DEFAULTS = {
-    'maxUrange': 80.0, 'maxRange': 80.0, 'linearUpdate': 1.0, 'angularUpdate': 0.5, 'temporalUpdate': -1.0,
-    'xmin': -100.0, 'ymin': -100.0, 'xmax': 100.0, 'ymax': 100.0, 'delta': 0.05,
-}
-# The particle filter's own (gmapping's). srr, srt, str and stt are these on the wheels' odometry
-# (scan_odometry 0); on the scan-matched track, unless given, a tenth of them
-# (_core.scan_odometry_motion(), rbpf_slam.h).
-GMAPPING_DEFAULTS = dict(COMMON_DEFAULTS, **{
-    'sigma': 0.05, 'kernelSize': 1, 'lstep': 0.05, 'astep': 0.05, 'iterations': 5, 'lsigma': 0.075, 'ogain': 3.0,
-    'lskip': 0, 'minimumScore': 0.0, 'srr': 0.1, 'srt': 0.2, 'str': 0.1, 'stt': 0.2, 'resampleThreshold': 0.5,
-    'particles': 30, 'llsamplerange': 0.01, 'llsamplestep': 0.01, 'lasamplerange': 0.005, 'lasamplestep': 0.005,
-    'seed': 0, 'scan_odometry': 1, 'threads': 2, 'best_switch_margin': 4.0,
-})
-# The pose graph's own (graph_slam.h; the node reads them under the same private names).
-GRAPH_DEFAULTS = dict(COMMON_DEFAULTS, **{
-    'linearUpdate': 0.5,  # a node every 0.5 m (graph_slam.h), half gmapping's
-    'match_max_range': 30.0, 'match_sigma': 0.075, 'local_match_sigma': -1.0, 'local_map_nodes': 40, 'local_search_window': 0.15,
-    'local_search_sigmas': 10.0, 'local_search_max_window': 0.3,
-    'local_search_angle': 0.15, 'local_min_score': 0.25, 'local_prior_margin': 0.03,
-    'local_prior_weight': 5.0, 'local_prior_points': 130.0, 'local_visible_only': 1, 'local_visible_side': 0, 'submap_nodes': 10, 'loop_search_radius': 1.0,
-    'loop_search_growth': 0.01, 'loop_search_max_radius': 6.0, 'loop_search_reach': 2.0, 'loop_search_angle': 0.35,
-    'loop_min_response': 0.55, 'loop_ambiguity': 0.9, 'loop_sigma_distance': 0.25, 'loop_visible_shift': 0.15, 'loop_candidates': 3, 'loop_recent_submap': 1, 'redundant_distance': 0.3,
-    'redundant_angle': 0.5, 'loop_solve_chi2': 7.8, 'keep_trimmed_scans': 0,
-})
 BACKENDS = ('graph', 'rbpf')
 DEFAULT_BACKEND = 'graph'  # the better on the Radish logs (bench/bench_slam.py)
-INT_PARAMS = {'kernelSize', 'iterations', 'lskip', 'particles', 'seed', 'threads', 'local_map_nodes', 'submap_nodes',
-              'loop_candidates'}
-MOTION_PARAMS = ('srr', 'srt', 'str', 'stt')
-BOOL_PARAMS = {'scan_odometry', 'local_visible_only', 'local_visible_side', 'loop_recent_submap', 'keep_trimmed_scans'}
+# [m] maxUrange and maxRange when not given: a log has no range_max to take them from (the node
+# takes the scan's).
+OFFLINE_MAX_RANGE = 80.0
 
 
-def defaults_of(backend: str) -> Dict[str, float]:
+def read_config(values: Dict[str, float], backend: str, laser_pose=(0.0, 0.0, 0.0)):
+    """slam_gmapping's parameters from node-named values (core/slam_config.h: the node's reader,
+    names and defaults); a name the backend does not read raises KeyError naming the nearest one."""
     if backend not in BACKENDS:
         raise ValueError('unknown SLAM backend "%s": use one of %s' % (backend, ', '.join(BACKENDS)))
-    return GRAPH_DEFAULTS if backend == 'graph' else GMAPPING_DEFAULTS
-
-
-def _merged(defaults, overrides, backend):
-    for key in overrides:
-        if key not in defaults:
-            near = difflib.get_close_matches(key, defaults, n=1)
-            raise KeyError('unknown %s SLAM parameter "%s"%s' % (backend, key, ' (did you mean "%s"?)' % near[0] if near else ''))
-    return dict(defaults, **overrides)
-
-
-def _matcher(v, laser_pose):
-    m = _core._ScanMatcherParams()
-    for name, key in (('sigma', 'sigma'), ('lstep', 'lstep'), ('astep', 'astep'), ('lsigma', 'lsigma')):
-        if key in v:
-            setattr(m, name, v[key])
-    for name, key in (('kernel_size', 'kernelSize'), ('iterations', 'iterations'), ('lskip', 'lskip')):
-        if key in v:
-            setattr(m, name, int(v[key]))
-    m.max_urange, m.max_range = v['maxUrange'], v['maxRange']
-    m.laser_pose = np.asarray(laser_pose, float)
-    return m
+    said = []
+    config, unknown = _core.read_slam_config(dict(values, backend=backend), '/slam_offline', said.append,
+                                             OFFLINE_MAX_RANGE)
+    for key in unknown:
+        why = next((w for w in said if '/%s ' % key in w), '')
+        raise KeyError('unknown %s SLAM parameter "%s"%s' % (backend, key, (': ' + why) if why else ''))
+    rbpf, graph = config.rbpf, config.graph
+    rbpf.matcher.laser_pose = np.asarray(laser_pose, float)
+    rbpf.share_with(graph)
+    rbpf.tracking = graph
+    return rbpf, graph
 
 
 def make_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0)):
     """_RbpfParams from gmapping-named values; an unknown name raises KeyError with the nearest one."""
-    v = _merged(GMAPPING_DEFAULTS, overrides, 'rbpf')
-    p = _core._RbpfParams()
-    p.particles, p.linear_update, p.angular_update = int(v['particles']), v['linearUpdate'], v['angularUpdate']
-    p.temporal_update, p.resample_threshold, p.ogain = v['temporalUpdate'], v['resampleThreshold'], v['ogain']
-    p.minimum_score, p.delta = v['minimumScore'], v['delta']
-    p.llsamplerange, p.llsamplestep = v['llsamplerange'], v['llsamplestep']
-    p.lasamplerange, p.lasamplestep = v['lasamplerange'], v['lasamplestep']
-    p.xmin, p.ymin, p.xmax, p.ymax = v['xmin'], v['ymin'], v['xmax'], v['ymax']
-    p.seed, p.threads, p.best_switch_margin = int(v['seed']), int(v['threads']), v['best_switch_margin']
-    p.scan_odometry = bool(v['scan_odometry'])
-    motion = _core.scan_odometry_motion() if p.scan_odometry else _core._MotionModelParams()
-    for key in MOTION_PARAMS:
-        if key in overrides or not p.scan_odometry:
-            setattr(motion, key, v[key])
-    p.motion = motion
-    p.matcher = _matcher(v, laser_pose)
-    # The track's local SLAM: the graph's defaults (a node every 0.5 m unless linearUpdate is
-    # given), as the node gives it.
-    p.tracking = make_graph_params({k: v[k] for k in COMMON_DEFAULTS if k != 'linearUpdate' or k in overrides}, laser_pose)
+    p, _ = read_config(overrides, 'rbpf', laser_pose)
     p.validate()
     return p
 
 
 def make_graph_params(overrides: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
     """_GraphSlamParams from node-named values (offline runs are synchronous unless asked)."""
-    v = _merged(GRAPH_DEFAULTS, overrides, 'graph')
-    p = _core._GraphSlamParams()
-    p.linear_update, p.angular_update, p.temporal_update = v['linearUpdate'], v['angularUpdate'], v['temporalUpdate']
-    p.delta, p.xmin, p.ymin, p.xmax, p.ymax = v['delta'], v['xmin'], v['ymin'], v['xmax'], v['ymax']
-    p.matcher = _matcher(v, laser_pose)
-    for key in GRAPH_DEFAULTS:
-        if key not in COMMON_DEFAULTS:
-            setattr(p, key, bool(v[key]) if key in BOOL_PARAMS else int(v[key]) if key in INT_PARAMS else float(v[key]))
+    _, p = read_config(overrides, 'graph', laser_pose)
     p.background = background
     p.validate()
     return p
@@ -182,7 +121,8 @@ class GraphSlam(_Backend):
 def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
     """background: the graph's loop closure in its own thread, as the node runs it (the particle
     filter has none)."""
-    defaults_of(backend)
+    if backend not in BACKENDS:
+        raise ValueError('unknown SLAM backend "%s": use one of %s' % (backend, ', '.join(BACKENDS)))
     if backend == 'graph':
         return GraphSlam(laser_pose=laser_pose, background=background, **params)
     return RbpfSlam(laser_pose=laser_pose, **params)
