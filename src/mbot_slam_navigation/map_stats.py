@@ -3,6 +3,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED
+
 
 @dataclass
 class MapStats:
@@ -18,7 +20,7 @@ class MapStats:
         return (self.free_cells + self.occupied_cells) * self.resolution ** 2
 
 
-def map_stats(msg, occupied_threshold: int = 65, free_threshold: int = 25) -> MapStats:
+def map_stats(msg, occupied_threshold: int = SAVER_OCCUPIED, free_threshold: int = SAVER_FREE) -> MapStats:
     """Counts cells as map_saver does: >= occupied_threshold occupied, <= free_threshold free."""
     data = np.asarray(msg.data, dtype=np.int16)
     return MapStats(width=msg.info.width, height=msg.info.height, resolution=msg.info.resolution,

@@ -15,7 +15,8 @@ import numpy as np
 import yaml
 
 FREE, OCCUPIED, UNKNOWN = 254, 0, 205
-# map_saver's default thresholds, occupancy values: >= 65 saved occupied, 0..25 free.
+# map_saver's default thresholds as OccupancyGrid values: >= SAVER_OCCUPIED saved occupied,
+# 0..SAVER_FREE free. Every module that calls a cell of a SLAM map occupied or free uses these.
 SAVER_OCCUPIED, SAVER_FREE = 65, 25
 
 

@@ -19,12 +19,25 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid
 from nav_msgs.srv import GetMap, GetMapResponse, LoadMap, LoadMapResponse
 
 from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, MapFileError, load_map, save_map
+from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import occupancy_grid_msg, pose_from_msg
+
+
+def read_parameters(r: ParamReader) -> dict:
+    """map_server's parameter."""
+    return {'frame_id': r.frame('frame_id', 'map', "the map's frame")}
+
+
+def read_saver_parameters(r: ParamReader) -> dict:
+    """map_saver's parameter (its thresholds and name are arguments)."""
+    return {'map': r.string('map', 'map', 'the map topic to save (or remap map:=TOPIC)')}
 
 
 class MapServer:
     def __init__(self, yaml_path: str):
-        self.frame_id = rospy.get_param('~frame_id', 'map')
+        r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+        self.frame_id = read_parameters(r)['frame_id']
+        r.report_unknown()
         self.map_pub = rospy.Publisher('map', OccupancyGrid, queue_size=1, latch=True)
         self.meta_pub = rospy.Publisher('map_metadata', MapMetaData, queue_size=1, latch=True)
         self.msg = None
@@ -96,7 +109,9 @@ def map_saver_main(argv=None):
     if not os.path.isdir(directory):
         parser.error('-f %s: folder %s does not exist' % (args.name, directory))
     rospy.init_node('map_saver', anonymous=True)
-    topic = rospy.get_param('~map', 'map')
+    r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+    topic = read_saver_parameters(r)['map']
+    r.report_unknown()
     received = []
     sub = rospy.Subscriber(topic, OccupancyGrid, received.append, queue_size=1)
     rospy.loginfo('map_saver: waiting up to %.0f s for a map on %s', args.timeout, sub.resolved_name)

@@ -16,6 +16,7 @@ from typing import Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
+from mbot_slam_navigation.maps.map_io import SAVER_OCCUPIED
 from mbot_slam_navigation.nav.frontiers import Grid
 
 Pose2 = Tuple[float, float, float]
@@ -77,7 +78,7 @@ def merge(grids: Sequence[Tuple[Grid, Pose2]], resolution: Optional[float] = Non
             np.maximum(trusted, np.where(d <= nearest + trust_margin, warped, -1), out=trusted)
         # occupied only where a trusted robot says so (the nearest robot knows every known cell, so
         # `trusted` is known wherever `out` is)
-        out = np.where((out >= 65) & (trusted < 65), trusted, out)
+        out = np.where((out >= SAVER_OCCUPIED) & (trusted < SAVER_OCCUPIED), trusted, out)
     return Grid(out.astype(np.int8), res, (x0, y0))
 
 
@@ -90,7 +91,7 @@ def _image(g: Grid) -> np.ndarray:
     d = g.data.astype(np.int16)
     img = np.full(d.shape, 128, np.uint8)
     img[(d >= 0) & (d < 50)] = 255
-    img[d >= 65] = 0
+    img[d >= SAVER_OCCUPIED] = 0
     img = cv2.resize(img, None, fx=UPSAMPLE, fy=UPSAMPLE, interpolation=cv2.INTER_NEAREST)
     return cv2.GaussianBlur(img, (3, 3), 0)
 
@@ -141,7 +142,7 @@ def _trail_pixels(trail: Sequence[Tuple[float, float]], origin: Tuple[float, flo
 
 
 def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius: float) -> Grid:
-    """m with its occupied cells (>= 65) within `radius` [m] of a robot's trail (world (x, y) points
+    """m with its occupied cells (>= SAVER_OCCUPIED) within `radius` [m] of a robot's trail (world (x, y) points
     in the order driven) made free: the robots' bodies stood there, so whatever a robot's laser saw
     there was a teammate, not a wall (a SLAM map keeps a teammate it saw standing in a doorway as an
     obstacle, which would close that door to the whole team). Unknown cells stay unknown."""
@@ -158,5 +159,5 @@ def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius
         for p in px:
             cv2.circle(mask, (int(p[0]), int(p[1])), r, 1, -1)
     data = m.data.copy()
-    data[(mask > 0) & (data >= 65)] = 0
+    data[(mask > 0) & (data >= SAVER_OCCUPIED)] = 0
     return Grid(data, m.resolution, m.origin)

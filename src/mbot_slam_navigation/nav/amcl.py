@@ -43,24 +43,32 @@ THROTTLE = 10.0  # [s] between repeats of one warning
 
 def read_parameters(r: ParamReader):
     """ROS amcl's parameters and defaults, checked; returns (core params, node settings dict)."""
-    p = _core._AmclParams()
-    p.min_particles = r.integer('min_particles', 100, minimum=1)
-    p.max_particles = r.integer('max_particles', 5000, minimum=1)
+    p = _core._AmclParams()  # its defaults are ROS amcl's (core/amcl.h)
+    p.min_particles = r.integer('min_particles', p.min_particles, 'fewest particles', minimum=1)
+    p.max_particles = r.integer('max_particles', p.max_particles, 'most particles', minimum=1)
     if p.max_particles < p.min_particles:
         raise ParamError('parameter %s (%d) must be >= %s (%d)' % (r.where('max_particles'), p.max_particles,
                                                                  r.where('min_particles'), p.min_particles))
-    p.kld_err = r.number('kld_err', 0.01, positive=True)
-    p.kld_z = r.number('kld_z', 0.99, positive=True)
-    p.recovery_alpha_slow = r.number('recovery_alpha_slow', 0.0, minimum=0.0)
-    p.recovery_alpha_fast = r.number('recovery_alpha_fast', 0.0, minimum=0.0)
-    odom_model = r.string('odom_model_type', 'diff')
+    p.kld_err = r.number('kld_err', p.kld_err, 'largest error between the true and the estimated distribution (KLD)',
+                         positive=True)
+    p.kld_z = r.number('kld_z', p.kld_z, 'upper standard normal quantile for (1 - p) of that error bound',
+                       positive=True)
+    p.recovery_alpha_slow = r.number('recovery_alpha_slow', p.recovery_alpha_slow,
+                                     'decay rate of the slow average weight (0: no random particles)', minimum=0.0)
+    p.recovery_alpha_fast = r.number('recovery_alpha_fast', p.recovery_alpha_fast,
+                                     'decay rate of the fast average weight (0: no random particles)', minimum=0.0)
+    odom_model = r.string('odom_model_type', 'diff', 'diff, omni, diff-corrected or omni-corrected (all corrected here)')
     if odom_model not in ODOM_MODELS:
         raise ParamError('parameter %s must be one of %s, got %r' % (r.where('odom_model_type'),
                                                                      ', '.join(ODOM_MODELS), odom_model))
     p.odom_model = ODOM_MODELS[odom_model]
-    for i in range(1, 6):
-        setattr(p, 'alpha%d' % i, r.number('odom_alpha%d' % i, 0.2, minimum=0.0))
-    laser_model = r.string('laser_model_type', 'likelihood_field')
+    for i, what in enumerate(('rotation noise from rotation', 'rotation noise from translation',
+                              'translation noise from translation', 'translation noise from rotation',
+                              'omni: strafe noise from translation'), start=1):
+        key = 'alpha%d' % i
+        setattr(p, key, r.number('odom_' + key, getattr(p, key), 'odometry model: ' + what, minimum=0.0))
+    laser_model = r.string('laser_model_type', 'likelihood_field',
+                           'likelihood_field, likelihood_field_prob (run as likelihood_field) or beam')
     if laser_model not in LASER_MODELS:
         raise ParamError('parameter %s must be one of %s, got %r' % (r.where('laser_model_type'),
                                                                      ', '.join(LASER_MODELS), laser_model))
@@ -68,47 +76,56 @@ def read_parameters(r: ParamReader):
         r.warn('parameter %s: likelihood_field_prob is run as likelihood_field (no beam skipping)'
                % r.where('laser_model_type'))
     p.laser_model = LASER_MODELS[laser_model]
-    p.max_beams = r.integer('laser_max_beams', 30, minimum=2)
-    p.z_hit = r.number('laser_z_hit', 0.95, minimum=0.0)
-    p.z_short = r.number('laser_z_short', 0.1, minimum=0.0)
-    p.z_max = r.number('laser_z_max', 0.05, minimum=0.0)
-    p.z_rand = r.number('laser_z_rand', 0.05, minimum=0.0)
-    p.sigma_hit = r.number('laser_sigma_hit', 0.2, positive=True)
-    p.lambda_short = r.number('laser_lambda_short', 0.1, positive=True)
-    p.likelihood_max_dist = r.number('laser_likelihood_max_dist', 2.0, positive=True)
+    p.max_beams = r.integer('laser_max_beams', p.max_beams, 'beams of each scan used in the update', minimum=2)
+    p.z_hit = r.number('laser_z_hit', p.z_hit, 'mixture weight of the hit part of the laser model', minimum=0.0)
+    p.z_short = r.number('laser_z_short', p.z_short, 'beam model: mixture weight of the short part', minimum=0.0)
+    p.z_max = r.number('laser_z_max', p.z_max, 'beam model: mixture weight of the max-range part', minimum=0.0)
+    p.z_rand = r.number('laser_z_rand', p.z_rand, 'mixture weight of the random part', minimum=0.0)
+    p.sigma_hit = r.number('laser_sigma_hit', p.sigma_hit, '[m] standard deviation of the hit part', positive=True)
+    p.lambda_short = r.number('laser_lambda_short', p.lambda_short, 'beam model: exponential decay of the short part',
+                              positive=True)
+    p.likelihood_max_dist = r.number('laser_likelihood_max_dist', p.likelihood_max_dist,
+                                     '[m] likelihood field: farthest obstacle distance computed', positive=True)
     try:
         p.validate()
     except ValueError as e:
         raise ParamError('%s: %s' % (r.ns, e)) from None
     s = {
-        'update_min_d': r.number('update_min_d', 0.2, minimum=0.0),
-        'update_min_a': r.number('update_min_a', math.pi / 6.0, minimum=0.0),
-        'resample_interval': r.integer('resample_interval', 2, minimum=1),
-        'transform_tolerance': r.number('transform_tolerance', 0.1, minimum=0.0),
-        'gui_publish_rate': r.number('gui_publish_rate', -1.0),
-        'save_pose_rate': r.number('save_pose_rate', 0.5),
-        'use_map_topic': r.boolean('use_map_topic', False),
-        'first_map_only': r.boolean('first_map_only', False),
-        'laser_min_range': r.number('laser_min_range', -1.0),
-        'laser_max_range': r.number('laser_max_range', -1.0),
-        'odom_frame_id': r.frame('odom_frame_id', 'odom'),
-        'base_frame_id': r.frame('base_frame_id', 'base_link'),
-        'global_frame_id': r.frame('global_frame_id', 'map'),
-        'tf_broadcast': r.boolean('tf_broadcast', True),
-        'initial_pose': (r.number('initial_pose_x', 0.0), r.number('initial_pose_y', 0.0),
-                         r.number('initial_pose_a', 0.0)),
-        'initial_cov': (r.number('initial_cov_xx', 0.5 * 0.5, minimum=0.0),
-                        r.number('initial_cov_yy', 0.5 * 0.5, minimum=0.0),
-                        r.number('initial_cov_aa', (math.pi / 12) ** 2, minimum=0.0)),
-        'seed': r.integer('seed', 0, minimum=0),
-        # Ours (Localizer): where to look when the scans stop fitting; 0 leaves it to recovery_alpha_*.
-        'recovery_search_radius': r.number('recovery_search_radius', 3.0, minimum=0.0),
-        'recovery_search_updates': r.integer('recovery_search_updates', 20, minimum=1),
+        'update_min_d': r.number('update_min_d', 0.2, '[m] travel before a filter update', minimum=0.0),
+        'update_min_a': r.number('update_min_a', math.pi / 6.0, '[rad] turn before a filter update', minimum=0.0),
+        'resample_interval': r.integer('resample_interval', 2, 'filter updates between resamplings', minimum=1),
+        'transform_tolerance': r.number('transform_tolerance', 0.1, '[s] how far ahead map -> odom is stamped',
+                                        minimum=0.0),
+        'gui_publish_rate': r.number('gui_publish_rate', -1.0, '[Hz] most often particlecloud is published (-1: no limit)'),
+        'save_pose_rate': r.number('save_pose_rate', 0.5,
+                                   '[Hz] how often the estimate is stored in ~initial_pose_* and ~initial_cov_* '
+                                   '(-1: never)'),
+        'use_map_topic': r.boolean('use_map_topic', False, 'read the map topic instead of calling static_map'),
+        'first_map_only': r.boolean('first_map_only', False, 'keep the first map, ignore later ones'),
+        'laser_min_range': r.number('laser_min_range', -1.0, "[m] shortest range used (-1: the scan's range_min)"),
+        'laser_max_range': r.number('laser_max_range', -1.0, "[m] longest range used (-1: the scan's range_max)"),
+        'odom_frame_id': r.frame('odom_frame_id', 'odom', 'the odometry frame'),
+        'base_frame_id': r.frame('base_frame_id', 'base_link', "the robot's base frame"),
+        'global_frame_id': r.frame('global_frame_id', 'map', 'the map frame'),
+        'tf_broadcast': r.boolean('tf_broadcast', True, 'broadcast map -> odom'),
+        'initial_pose': (r.number('initial_pose_x', 0.0, '[m] initial pose mean, x'),
+                         r.number('initial_pose_y', 0.0, '[m] initial pose mean, y'),
+                         r.number('initial_pose_a', 0.0, '[rad] initial pose mean, yaw')),
+        'initial_cov': (r.number('initial_cov_xx', 0.5 * 0.5, '[m^2] initial pose covariance, x x', minimum=0.0),
+                        r.number('initial_cov_yy', 0.5 * 0.5, '[m^2] initial pose covariance, y y', minimum=0.0),
+                        r.number('initial_cov_aa', (math.pi / 12) ** 2, '[rad^2] initial pose covariance, yaw yaw',
+                                 minimum=0.0)),
+        'seed': r.integer('seed', 0, "ours: the random generator's seed", minimum=0),
+        'recovery_search_radius': r.number('recovery_search_radius', 3.0,
+                                           '[m] ours: how far around the estimate to search when the scans stop '
+                                           'fitting the map (0: leave it to recovery_alpha_*)', minimum=0.0),
+        'recovery_search_updates': r.integer('recovery_search_updates', 20,
+                                             'ours: how many updates that search lasts', minimum=1),
     }
     for key in IGNORED:
         if r.has(key):
-            r.raw(key)
             r.warn('parameter %s is not implemented here and is ignored' % r.where(key))
+        r.ignored(key, "ROS amcl's beam skipping and selective resampling are not implemented")
     return p, s
 
 

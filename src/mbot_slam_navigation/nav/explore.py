@@ -23,31 +23,8 @@ Then the robot returns to its start pose (not when stuck or on error; within ret
 written to ~report_dir if set (mbot_slam_navigation.explore_report), and `explore/complete`
 (std_msgs/Bool, latched) turns true.
 
-explore_lite's parameters: robot_base_frame (base_footprint here), costmap_topic
-(move_base/global_costmap/costmap), planner_frequency (0.33 Hz), progress_timeout (30 s),
-potential_scale (3.0), gain_scale (1.0), orientation_scale (accepted, unused), min_frontier_size
-(0.75 m), visualize (true: `explore/frontiers`, visualization_msgs/MarkerArray),
-transform_tolerance (0.3 s). Ours: map_topic (map), gain_size_max (5 m: a frontier's size counts
-in its gain up to this, so that the edge of the laser's view down a long corridor does not
-outweigh the frontiers behind the robot; 0: no cap), blacklist_timeout (60 s), max_tries (2),
-hysteresis (1.0), switch_back_after (60 s), min_unknown_area (3 m^2: enclosed unknown space
-smaller than this, the inside of furniture, makes no frontier unless free floor bounds most of it:
-then it is floor in a shadow), min_unknown_beside (0.25 m^2: a frontier with less unknown space
-within 1 m of it is given up, a sliver the laser grazed), tour_frontiers (20: the frontiers re-ranked by the
-shortest tour through the goals of the 20 best, frontiers.tour_order, so that the robot finishes one
-side before it crosses to the other, and takes a small frontier it passes rather than coming back
-for it; at most 40; 0 or 1: explore_lite's greedy choice; a team's robots choose greedily),
-return_to_start (true), report_dir (''), world_name ('' = the simulator's /gazebo/world_name, for
-ground-truth figures), robot_radius (0.2 m), progress_period (10 s: the
-progress line), shutdown_when_done (false), max_duration (0 s: none), return_timeout (120 s),
-scan_topic (scan) and cmd_vel_topic (cmd_vel) for backing out, escape_distance (0.6 m),
-escape_speed (0.1 m/s), escape_timeout (30 s), max_goals_per_place (5: new goals sent within 0.6 m
-of one place before its frontier is given up; with the blacklist, this bounds every run),
-startup_timeout (300 s of wall time for move_base, the map, the costmap and the robot pose; then
-the report says not_started and why), model_name ('': the simulator's contacts of every robot count;
-a team sets each robot's own), read_period (0.02 s of wall time: /clock and /tf are read at most
-this often, in batches, see batched_reads; the time and the pose then lag by up to that; 0: every
-message as it comes).
+Parameters: read_parameters() (the reference page: docs/nodes/explore.md): explore_lite's names and
+defaults, then ours.
 
 A team (launch/multi_explore.launch): with team_topic set (e.g. /explore/team), each explorer says
 where its robot is and where it goes (mbot_slam_navigation/ExplorerState, every cycle, under
@@ -61,6 +38,7 @@ import math
 import os
 import time
 import traceback
+from types import SimpleNamespace
 from typing import List, Optional, Tuple
 
 import numpy as np
@@ -84,9 +62,9 @@ from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
-from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, GoalFields, Grid, MotionWatch,
-                                                Plateau, Teammate, rank_frontiers, share_out, tour_order,
-                                                yields_goal)
+from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, POTENTIAL_SCALE, ExploreState,
+                                                Frontier, GivenUp, GoalFields, Grid, MotionWatch, Plateau, Teammate,
+                                                rank_frontiers, share_out, tour_order, yields_goal)
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
@@ -121,59 +99,124 @@ def grid_of(msg: OccupancyGrid) -> Grid:
                 (msg.info.origin.position.x, msg.info.origin.position.y))
 
 
+def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> SimpleNamespace:
+    """explore's parameters: explore_lite's names and defaults, then ours; checked (ParamError)."""
+    c = SimpleNamespace()
+    c.robot_base_frame = r.frame('robot_base_frame', 'base_footprint', "the robot's base frame")
+    c.global_frame = r.frame('global_frame', 'map', 'the map frame')
+    c.costmap_topic = r.string('costmap_topic', 'move_base/global_costmap/costmap',
+                               "move_base's global costmap: goals are placed and paths measured on it")
+    r.string('costmap_updates_topic', '', "explore_lite's; not used (the full costmap topic is enough here)")
+    c.map_topic = r.string('map_topic', 'map', "ours: the SLAM map, whose frontiers are explored")
+    c.planner_frequency = r.number('planner_frequency', 0.33, '[Hz] how often frontiers are found and a goal chosen',
+                                   positive=True)
+    c.potential_scale = r.number('potential_scale', POTENTIAL_SCALE, "weight of a frontier's path length in its cost", minimum=0.0)
+    c.gain_scale = r.number('gain_scale', GAIN_SCALE, "weight of a frontier's size in its cost", minimum=0.0)
+    c.gain_size_max = r.number('gain_size_max', 5.0,
+                               '[m] ours: a frontier counts in its gain up to this size (0: no cap)', minimum=0.0)
+    if r.number('orientation_scale', 0.0, "explore_lite's; not used (goals face the way the robot goes)") != 0.0:
+        r.warn('explore: orientation_scale is not used (goals face the way the robot goes)')
+    c.min_frontier_size = r.number('min_frontier_size', MIN_FRONTIER_SIZE, '[m] smallest frontier explored',
+                                   minimum=0.0)
+    c.min_unknown_area = r.number('min_unknown_area', 3.0,
+                                  '[m^2] ours: enclosed unknown space smaller than this (the inside of furniture) makes '
+                                  'no frontier unless free floor bounds most of it', minimum=0.0)
+    c.min_unknown_beside = r.number('min_unknown_beside', 0.25,
+                                    '[m^2] ours: a frontier with less unknown space within 1 m is given up (a sliver '
+                                    'the laser grazed)', minimum=0.0)
+    c.tour_frontiers = r.integer('tour_frontiers', 20,
+                                 'ours: the best this many frontiers are re-ranked by the shortest tour through their '
+                                 'goals (at most %d; 0 or 1: greedy as explore_lite)' % MAX_TOUR_FRONTIERS, minimum=0)
+    if c.tour_frontiers > MAX_TOUR_FRONTIERS:
+        # a tour beyond 12 goals costs about n^4 steps and a path-length field per goal: 5 ms at
+        # 40, 24 ms at 60, seconds at a few hundred, every cycle
+        r.warn('explore: ~tour_frontiers %d: more than %d makes every cycle slow; using %d'
+               % (c.tour_frontiers, MAX_TOUR_FRONTIERS, MAX_TOUR_FRONTIERS))
+        c.tour_frontiers = MAX_TOUR_FRONTIERS
+    c.visualize = r.boolean('visualize', True, 'publish the frontiers on explore/frontiers')
+    c.transform_tolerance = r.number('transform_tolerance', 0.3, "[s] how old the robot's pose may be", positive=True)
+    c.progress_timeout = r.number('progress_timeout', 30.0,
+                                  '[s] a goal the robot makes no progress towards for this long is blacklisted',
+                                  positive=True)
+    c.blacklist_timeout = r.number('blacklist_timeout', 60.0, '[s] ours: how long a failed goal stays blacklisted',
+                                   minimum=0.0)
+    c.max_tries = r.integer('max_tries', 2, 'ours: failures after which a frontier is given up', minimum=1)
+    c.hysteresis = r.number('hysteresis', 1.0, 'ours: another goal must beat the current one by this cost', minimum=0.0)
+    c.switch_back_after = r.number('switch_back_after', 60.0,
+                                   '[s] ours: a goal left for a better one is not taken again for this long',
+                                   minimum=0.0)
+    c.max_goals_per_place = r.integer('max_goals_per_place', 5,
+                                      'ours: goals sent within 0.6 m of one place before its frontier is given up',
+                                      minimum=1)
+    c.return_to_start = r.boolean('return_to_start', True, 'ours: drive back to the start pose when done')
+    c.report_dir = r.string('report_dir', '', "ours: where the report is written ('': none)")
+    c.world_name = r.string('world_name', '',
+                            "ours: the world file, for ground-truth figures ('': the simulator's /gazebo/world_name)")
+    c.robot_radius = r.number('robot_radius', 0.2, "[m] ours: the robot's radius (reachability, backing out)",
+                              positive=True)
+    c.progress_period = r.number('progress_period', 10.0, '[s] ours: between progress lines', positive=True)
+    c.shutdown_when_done = r.boolean('shutdown_when_done', False, 'ours: end the launch when the exploration ends')
+    c.max_duration = r.number('max_duration', 0.0, '[s] ours: simulated time before the outcome is timeout (0: none)',
+                              minimum=0.0)
+    c.startup_timeout = r.number('startup_timeout', 300.0,
+                                 '[s] ours: wall time to wait for move_base, the map, the costmap and the pose',
+                                 positive=True)
+    c.read_period = r.number('read_period', 0.02,
+                             '[s] ours: /clock and /tf are read at most this often, in batches (0: every message)',
+                             minimum=0.0)
+    c.return_timeout = r.number('return_timeout', 120.0, '[s] ours: time allowed to return to the start',
+                                positive=True)
+    c.escape_distance = r.number('escape_distance', 0.6, '[m] ours: how far to back out along the path when stuck',
+                                 positive=True)
+    c.escape_speed = r.number('escape_speed', 0.1, '[m/s] ours: backing-out speed', positive=True)
+    c.escape_timeout = r.number('escape_timeout', 30.0, '[s] ours: time allowed to back out', positive=True)
+    c.scan_topic = r.string('scan_topic', 'scan', 'ours: the laser, checked while backing out')
+    c.cmd_vel_topic = r.string('cmd_vel_topic', 'cmd_vel', 'ours: velocity commands while backing out')
+    c.model_name = r.string('model_name', '',
+                            "ours: the simulator's model whose contacts count as collisions ('': every robot's)")
+    c.team_topic = r.string('team_topic', '', "ours: the team's topic (e.g. /explore/team; '': alone)")
+    c.robot_name = r.string('robot_name', default_robot_name, "ours: this robot's name in the team (default: namespace)")
+    c.claim_radius = r.number('claim_radius', 2.0, "[m] ours: a frontier whose goal is this near a teammate's goal "
+                              "is left to it", minimum=0.0)
+    return c
+
+
 class Explore:
     def __init__(self):
         r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
-        self.base_frame = r.frame('robot_base_frame', 'base_footprint')
-        self.global_frame = r.frame('global_frame', 'map')
-        self.costmap_topic = costmap_topic = r.string('costmap_topic', 'move_base/global_costmap/costmap')
-        r.string('costmap_updates_topic', '')  # explore_lite's; the full costmap topic is enough here
-        self.map_topic = map_topic = r.string('map_topic', 'map')
-        self.period = 1.0 / r.number('planner_frequency', 0.33, positive=True)
-        self.potential_scale = r.number('potential_scale', 3.0, minimum=0.0)
-        self.gain_scale = r.number('gain_scale', 1.0, minimum=0.0)
-        self.gain_size_max = r.number('gain_size_max', 5.0, minimum=0.0)
-        if r.number('orientation_scale', 0.0) != 0.0:
-            rospy.logwarn('explore: orientation_scale is not used (goals face the way the robot goes)')
-        self.min_frontier_size = r.number('min_frontier_size', 0.75, minimum=0.0)
-        self.min_unknown_area = r.number('min_unknown_area', 3.0, minimum=0.0)
-        self.min_unknown_beside = r.number('min_unknown_beside', 0.25, minimum=0.0)
-        self.tour_frontiers = r.integer('tour_frontiers', 20, minimum=0)
-        if self.tour_frontiers > MAX_TOUR_FRONTIERS:
-            # a tour beyond 12 goals costs about n^4 steps and a path-length field per goal: 5 ms at
-            # 40, 24 ms at 60, seconds at a few hundred, every cycle
-            rospy.logwarn('explore: ~tour_frontiers %d: more than %d makes every cycle slow; using %d'
-                          % (self.tour_frontiers, MAX_TOUR_FRONTIERS, MAX_TOUR_FRONTIERS))
-            self.tour_frontiers = MAX_TOUR_FRONTIERS
-        self.goal_fields = GoalFields()  # tour_order's path lengths, kept between cycles
-        self.visualize = r.boolean('visualize', True)
-        self.transform_tolerance = r.number('transform_tolerance', 0.3, positive=True)
-        self.state = ExploreState(progress_timeout=r.number('progress_timeout', 30.0, positive=True),
-                                  blacklist_timeout=r.number('blacklist_timeout', 60.0, minimum=0.0),
-                                  max_tries=r.integer('max_tries', 2, minimum=1),
-                                  hysteresis=r.number('hysteresis', 1.0, minimum=0.0),
-                                  switch_back_after=r.number('switch_back_after', 60.0, minimum=0.0),
-                                  max_goals_per_place=r.integer('max_goals_per_place', 5, minimum=1))
-        self.return_to_start = r.boolean('return_to_start', True)
-        self.report_dir = r.string('report_dir', '')
-        self.world_name = r.string('world_name', '') or rospy.get_param('/gazebo/world_name', '')
-        self.robot_radius = r.number('robot_radius', 0.2, positive=True)
-        self.progress_period = r.number('progress_period', 10.0, positive=True)
-        self.shutdown_when_done = r.boolean('shutdown_when_done', False)
-        self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
-        self.startup_timeout = r.number('startup_timeout', 300.0, positive=True)
-        read_period = r.number('read_period', 0.02, minimum=0.0)
-        self.return_timeout = r.number('return_timeout', 120.0, positive=True)
-        self.escape_distance = r.number('escape_distance', 0.6, positive=True)
-        self.escape_speed = r.number('escape_speed', 0.1, positive=True)
-        self.escape_timeout = r.number('escape_timeout', 30.0, positive=True)
-        scan_topic = r.string('scan_topic', 'scan')
-        cmd_vel_topic = r.string('cmd_vel_topic', 'cmd_vel')
-        self.model_name = r.string('model_name', '')
-        team_topic = r.string('team_topic', '')
-        self.robot_name = r.string('robot_name', rospy.get_namespace().strip('/') or 'robot')
-        self.claim_radius = r.number('claim_radius', 2.0, minimum=0.0)
+        c = read_parameters(r, rospy.get_namespace().strip('/') or 'robot')
         r.report_unknown()
+        self.base_frame = c.robot_base_frame
+        self.global_frame = c.global_frame
+        self.costmap_topic = costmap_topic = c.costmap_topic
+        self.map_topic = map_topic = c.map_topic
+        self.period = 1.0 / c.planner_frequency
+        self.potential_scale, self.gain_scale, self.gain_size_max = c.potential_scale, c.gain_scale, c.gain_size_max
+        self.min_frontier_size = c.min_frontier_size
+        self.min_unknown_area, self.min_unknown_beside = c.min_unknown_area, c.min_unknown_beside
+        self.tour_frontiers = c.tour_frontiers
+        self.goal_fields = GoalFields()  # tour_order's path lengths, kept between cycles
+        self.visualize = c.visualize
+        self.transform_tolerance = c.transform_tolerance
+        self.state = ExploreState(progress_timeout=c.progress_timeout, blacklist_timeout=c.blacklist_timeout,
+                                  max_tries=c.max_tries, hysteresis=c.hysteresis,
+                                  switch_back_after=c.switch_back_after, max_goals_per_place=c.max_goals_per_place)
+        self.return_to_start = c.return_to_start
+        self.report_dir = c.report_dir
+        self.world_name = c.world_name or rospy.get_param('/gazebo/world_name', '')
+        self.robot_radius = c.robot_radius
+        self.progress_period = c.progress_period
+        self.shutdown_when_done = c.shutdown_when_done
+        self.max_duration = c.max_duration
+        self.startup_timeout = c.startup_timeout
+        read_period = c.read_period
+        self.return_timeout = c.return_timeout
+        self.escape_distance, self.escape_speed, self.escape_timeout = c.escape_distance, c.escape_speed, c.escape_timeout
+        scan_topic, cmd_vel_topic = c.scan_topic, c.cmd_vel_topic
+        self.model_name = c.model_name
+        team_topic = c.team_topic
+        self.robot_name = c.robot_name
+        self.claim_radius = c.claim_radius
 
         self.map: Optional[Grid] = None
         self.map_with_stamp: Tuple[Optional[Grid], rospy.Time] = (None, rospy.Time(0))

@@ -18,7 +18,11 @@ import cv2
 import numpy as np
 
 from mbot_slam_navigation import _core
+from mbot_slam_navigation.maps.map_io import SAVER_OCCUPIED
 
+# explore's defaults (explore.read_parameters reads them; explore_lite's values)
+MIN_FRONTIER_SIZE = 0.75  # [m]
+POTENTIAL_SCALE, GAIN_SCALE = 3.0, 1.0
 COST_INSCRIBED = 99  # costmap_2d's OccupancyGrid translation: 99 inscribed, 100 lethal, -1 unknown
 
 
@@ -68,12 +72,12 @@ class GivenUp:
         return {'x': round(self.x, 2), 'y': round(self.y, 2), 'size_m': round(self.size_m, 2), 'why': self.why}
 
 
-def frontier_groups(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> List[np.ndarray]:
+def frontier_groups(m: Grid, occupied_min: int = SAVER_OCCUPIED, min_unknown_area: float = 0.0) -> List[np.ndarray]:
     """The frontiers of map m as arrays of (row, col), largest first (see unknown_space)."""
     return _frontier_groups(m, unknown_space(m, occupied_min, min_unknown_area), occupied_min)
 
 
-def unknown_space(m: Grid, occupied_min: int = 65, min_unknown_area: float = 0.0) -> np.ndarray:
+def unknown_space(m: Grid, occupied_min: int = SAVER_OCCUPIED, min_unknown_area: float = 0.0) -> np.ndarray:
     """The cells of map m (uint8 mask) whose unknown space is there to explore.
 
     Unknown space that the map encloses (not reaching its edge) and smaller than min_unknown_area
@@ -134,7 +138,7 @@ def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int) -> List[np
     return sorted(groups, key=len, reverse=True)
 
 
-def passable(costmap: Grid, m: Grid, occupied_min: int = 65) -> np.ndarray:
+def passable(costmap: Grid, m: Grid, occupied_min: int = SAVER_OCCUPIED) -> np.ndarray:
     """Costmap cells the robot's centre may cross: cost below inscribed, and known and not occupied
     in the map (the costmap may count unknown space as free)."""
     cost = costmap.data.astype(np.int16)
@@ -168,10 +172,10 @@ def _sees(cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, cells: np.ndarra
     return ~np.any(cost[r, c] >= 100, axis=1)
 
 
-def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_frontier_size: float = 0.5,
-                   potential_scale: float = 3.0, gain_scale: float = 1.0, avoid: Sequence[Tuple[float, float]] = (),
+def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_frontier_size: float = MIN_FRONTIER_SIZE,
+                   potential_scale: float = POTENTIAL_SCALE, gain_scale: float = GAIN_SCALE, avoid: Sequence[Tuple[float, float]] = (),
                    avoid_radius: float = 0.6, goal_reach: float = 0.4, goal_cost_max: int = 50,
-                   occupied_min: int = 65, min_unknown_area: float = 0.0, escape_radius: float = 0.35,
+                   occupied_min: int = SAVER_OCCUPIED, min_unknown_area: float = 0.0, escape_radius: float = 0.35,
                    stats: Optional[dict] = None, avoid_goals: Sequence[Tuple[float, float]] = (),
                    unreachable: Optional[List[GivenUp]] = None,
                    keep_goal: Optional[Tuple[float, float]] = None,

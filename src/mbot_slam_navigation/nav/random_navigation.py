@@ -201,21 +201,35 @@ class Tally:
         return '\n'.join(lines)
 
 
+def read_parameters(r: ParamReader) -> dict:
+    """The node's parameters (the tutorial's script has none; all are ours), checked."""
+    return {
+        'rest_time': r.number('rest_time', 2.0, '[s] pause at each goal, as the tutorial', minimum=0.0),
+        'max_goals': r.integer('max_goals', 0, 'stop after this many goals (0: never, as the tutorial)', minimum=0),
+        'max_duration': r.number('max_duration', 0.0, '[s] stop after this much time (0: never)', minimum=0.0),
+        'goal_timeout': r.number('goal_timeout', 300.0, '[s] a goal not reached in this time is cancelled',
+                                 positive=True),
+        'server_timeout': r.number('server_timeout', 60.0, '[s] wait for the move_base action server',
+                                   positive=True),
+        'frame_id': r.frame('frame_id', 'map', "the goals' frame"),
+        'base_frame': r.frame('base_frame', 'base_footprint', "the robot's base frame (distance travelled)"),
+        'seed': r.integer('seed', -1, "the random order's seed (-1: a different order each run)"),
+        'locations_file': r.string('locations_file', '',
+                                   "a YAML of named poses ('': the tutorial's nine places in the home)"),
+    }
+
+
 class RandomNavigation:
     """The node (the tutorial's NavTest): run() sends the goals and returns the exit code."""
 
     def __init__(self):
         r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
-        self.rest_time = r.number('rest_time', 2.0, minimum=0.0)
-        self.max_goals = r.integer('max_goals', 0, minimum=0)
-        self.max_duration = r.number('max_duration', 0.0, minimum=0.0)
-        self.goal_timeout = r.number('goal_timeout', 300.0, positive=True)
-        self.server_timeout = r.number('server_timeout', 60.0, positive=True)
-        self.frame_id = r.frame('frame_id', 'map')
-        self.base_frame = r.frame('base_frame', 'base_footprint')
-        seed = r.integer('seed', -1)
-        locations_file = r.string('locations_file', '')
+        c = read_parameters(r)
         r.report_unknown()
+        self.rest_time, self.max_goals, self.max_duration = c['rest_time'], c['max_goals'], c['max_duration']
+        self.goal_timeout, self.server_timeout = c['goal_timeout'], c['server_timeout']
+        self.frame_id, self.base_frame = c['frame_id'], c['base_frame']
+        seed, locations_file = c['seed'], c['locations_file']
         self.locations = load_locations(os.path.expanduser(locations_file)) if locations_file else tutorial_locations()
         for loc in self.locations:
             if loc.note:

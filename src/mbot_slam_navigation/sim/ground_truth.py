@@ -8,6 +8,7 @@ from typing import Tuple
 
 import numpy as np
 
+from mbot_slam_navigation.maps.map_io import SAVER_OCCUPIED
 from mbot_slam_navigation.sim.sdf_world import World
 
 
@@ -45,7 +46,7 @@ def distance_to_surfaces(world: World, points: np.ndarray, chunk: int = 2048) ->
     return out
 
 
-def occupied_points(msg, threshold: int = 65) -> np.ndarray:
+def occupied_points(msg, threshold: int = SAVER_OCCUPIED) -> np.ndarray:
     """World positions [m] of the centres of a nav_msgs/OccupancyGrid's occupied cells."""
     data = np.asarray(msg.data, np.int16).reshape(msg.info.height, msg.info.width)
     rows, cols = np.nonzero(data >= threshold)

@@ -35,6 +35,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from mbot_slam_navigation.msg import Contact
+from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.nonblocking_publisher import nonblocking_publisher
 from mbot_slam_navigation.sim import pacing
@@ -81,21 +82,48 @@ class RobotIO:
             p.unregister()
 
 
+def read_parameters(r: ParamReader) -> dict:
+    """gazebo_ros's parameters that apply here, then ours; checked (ParamError)."""
+    c = {'real_time_factor': r.raw('real_time_factor', 1.0,
+                                   "simulated seconds per wall second: a number (0: as fast as possible) or 'auto' "
+                                   '(as fast as the nodes keep up)', 'double or auto')}
+    c['min_real_time_factor'] = r.number('min_real_time_factor', pacing.MIN_RTF, "'auto': the slowest pace",
+                                         positive=True)
+    c['max_real_time_factor'] = r.number('max_real_time_factor', pacing.MAX_RTF, "'auto': the fastest pace",
+                                         positive=True)
+    c['max_lag'] = r.number('max_lag', pacing.MAX_LAG,
+                            '[s] simulated time the slowest node (its heartbeat) may fall behind before the clock waits',
+                            positive=True)
+    c['max_hold'] = r.number('max_hold', pacing.MAX_HOLD, '[s] wall time the clock waits for a late node at most',
+                             minimum=0.0)
+    c['step_size'] = r.number('step_size', 0.01, '[s] the physics step', positive=True)
+    c['pub_clock_frequency'] = r.number('pub_clock_frequency', 100.0, '[Hz] simulated rate of /clock', positive=True)
+    c['paused'] = r.boolean('paused', False, 'start paused (/gazebo/unpause_physics starts it)')
+    c['gui'] = r.boolean('gui', False, 'open the top-down viewer window')
+    c['gazebo_namespace'] = r.string('gazebo_namespace', 'gazebo', "the services' and topics' namespace")
+    c['world_name'] = r.string('world_name', '', "the SDF world file ('': an empty world)")
+    c['odometry_slip_stddev'] = r.number('odometry_slip_stddev', 0.02,
+                                         "ours: relative standard deviation of the wheels' slip (0: exact odometry)",
+                                         minimum=0.0)
+    c['cmd_vel_timeout'] = r.number('cmd_vel_timeout', 0.5, '[s] ours: the robot stops when cmd_vel falls silent this '
+                                    'long', positive=True)
+    c['seed'] = r.integer('seed', 0, "ours: the random generator's seed (slip, laser noise)")
+    return c
+
+
 class SimNode:
     def __init__(self):
-        self.pacer = make_pacer(rospy.get_param('~real_time_factor', 1.0),
-                                min_rtf=float(rospy.get_param('~min_real_time_factor', pacing.MIN_RTF)),
-                                max_rtf=float(rospy.get_param('~max_real_time_factor', pacing.MAX_RTF)),
-                                max_lag=float(rospy.get_param('~max_lag', pacing.MAX_LAG)),
-                                max_hold=float(rospy.get_param('~max_hold', pacing.MAX_HOLD)))
-        step = float(rospy.get_param('~step_size', 0.01))
-        clock_hz = float(rospy.get_param('~pub_clock_frequency', 100.0))
-        self.paused = bool(rospy.get_param('~paused', False))
-        self.gui = bool(rospy.get_param('~gui', False))
-        self.gz_ns = '/' + rospy.get_param('~gazebo_namespace', 'gazebo').strip('/')
-        world_path = rospy.get_param('~world_name', '')
-        if not clock_hz > 0:
-            raise ValueError('~pub_clock_frequency must be > 0 (got %r)' % clock_hz)
+        r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
+        c = read_parameters(r)
+        r.report_unknown()
+        self.pacer = make_pacer(c['real_time_factor'], min_rtf=c['min_real_time_factor'],
+                                max_rtf=c['max_real_time_factor'], max_lag=c['max_lag'], max_hold=c['max_hold'])
+        step = c['step_size']
+        clock_hz = c['pub_clock_frequency']
+        self.paused = c['paused']
+        self.gui = c['gui']
+        self.gz_ns = '/' + c['gazebo_namespace'].strip('/')
+        world_path = c['world_name']
         if world_path:
             world = load_world(world_path)  # raises XmlError naming file and line
         else:
@@ -105,9 +133,8 @@ class SimNode:
         rospy.loginfo('gazebo_sim: world "%s" from %s: %d shapes%s', world.name, world_path or '(empty)',
                       len(world.shapes), ', %d people' % len(world.actors) if world.actors else '')
         self.sim = Simulation(world, step_size=step,
-                              slip_stddev=float(rospy.get_param('~odometry_slip_stddev', 0.02)),
-                              cmd_timeout=float(rospy.get_param('~cmd_vel_timeout', 0.5)),
-                              seed=int(rospy.get_param('~seed', 0)))
+                              slip_stddev=c['odometry_slip_stddev'], cmd_timeout=c['cmd_vel_timeout'],
+                              seed=c['seed'])
         self.clock_period = 1.0 / clock_hz
         self.next_clock = 0.0
         self.lock = threading.RLock()
