@@ -93,7 +93,7 @@ def write_map(msg: OccupancyGrid, basename: str, occupied: int, free: int) -> No
              occupied_thresh=occupied / 100.0, free_thresh=free / 100.0)
 
 
-def map_saver_main(argv=None):
+def saver_argument_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog='map_saver', description='Saves the map published on "map" as NAME.pgm and NAME.yaml '
                                       '(map:=TOPIC or _map:=TOPIC reads another topic).')
@@ -102,6 +102,11 @@ def map_saver_main(argv=None):
     parser.add_argument('--free', type=int, default=SAVER_FREE, help='free threshold, 0..100 (default %(default)s)')
     parser.add_argument('--timeout', type=float, default=30.0,
                         help='seconds (wall clock) to wait for a map before giving up (default 30)')
+    return parser
+
+
+def map_saver_main(argv=None):
+    parser = saver_argument_parser()
     args = parser.parse_args(rospy.myargv(argv if argv is not None else sys.argv)[1:])
     if not (0 <= args.free < args.occ <= 100):
         parser.error('thresholds must satisfy 0 <= --free (%d) < --occ (%d) <= 100' % (args.free, args.occ))

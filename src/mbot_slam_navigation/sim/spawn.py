@@ -11,7 +11,7 @@ from mbot_slam_navigation.transforms import yaw_to_quaternion
 from mbot_slam_navigation.srv import SpawnModel, SpawnModelRequest
 
 
-def parse_args(argv):
+def argument_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='spawn_model', description='Spawn a URDF robot or SDF people in the 2D simulator.')
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument('-param', help='parameter holding the URDF (e.g. robot_description)')
@@ -20,14 +20,19 @@ def parse_args(argv):
     kind.add_argument('-urdf', action='store_true', help='the model is URDF (a robot; the default)')
     kind.add_argument('-sdf', action='store_true', help='the model is SDF with <actor>s (people)')
     p.add_argument('-model', required=True, help='model name')
-    for axis in ('x', 'y', 'z', 'R', 'P', 'Y'):
-        p.add_argument('-' + axis, type=float, default=0.0)
-    p.add_argument('-robot_namespace', default='')
-    p.add_argument('-gazebo_namespace', default='/gazebo')
-    p.add_argument('-reference_frame', default='')
-    p.add_argument('-unpause', action='store_true')
+    for axis, what in (('x', '[m] x'), ('y', '[m] y'), ('z', '[m] z (ignored: the world is flat)'),
+                       ('R', '[rad] roll (ignored)'), ('P', '[rad] pitch (ignored)'), ('Y', '[rad] yaw')):
+        p.add_argument('-' + axis, type=float, default=0.0, help=what + ' of the spawn pose')
+    p.add_argument('-robot_namespace', default='', help="the robot's topics' namespace")
+    p.add_argument('-gazebo_namespace', default='/gazebo', help="the simulator's namespace")
+    p.add_argument('-reference_frame', default='', help="the pose's frame ('' or world)")
+    p.add_argument('-unpause', action='store_true', help='unpause the simulation after spawning')
     p.add_argument('-wait', type=float, default=60.0, help='seconds to wait for the simulator')
-    return p.parse_args(argv)
+    return p
+
+
+def parse_args(argv):
+    return argument_parser().parse_args(argv)
 
 
 def main():

@@ -136,7 +136,7 @@ def parse_param(text):
         raise argparse.ArgumentTypeError('--param takes name=value with a number, got "%s"' % text) from None
 
 
-def main(argv=None):
+def argument_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog='slam_offline', description=__doc__.split('\n')[0])
     ap.add_argument('log', help='CARMEN log (.clf, .log, optionally .bz2) or rosbag (.bag)')
     ap.add_argument('-o', '--out', help='output base name (default: the log name without extension)')
@@ -144,6 +144,11 @@ def main(argv=None):
     ap.add_argument('--backend', choices=BACKENDS, default=DEFAULT_BACKEND, help='SLAM backend (default %(default)s)')
     ap.add_argument('--param', action='append', type=parse_param, default=[], help='slam_gmapping name=value')
     ap.add_argument('--quiet', action='store_true', help='no progress bar')
+    return ap
+
+
+def main(argv=None):
+    ap = argument_parser()
     args = ap.parse_args(argv)
     if not os.path.isfile(args.log):
         ap.error('log file %s does not exist' % args.log)
