@@ -1,5 +1,7 @@
-// move_base (roscpp): actionlib server, planning / controlling / clearing states, recoveries, over
-// the core's costmaps, hierarchical global planner and trajectory controller.
+// move_base (roscpp): the actionlib server, tf, the costmaps' ROS side, the recoveries' motions and
+// the publishers, around the core's state machine (core/move_base_fsm.h: planning, controlling,
+// clearing, patience, oscillation, the recoveries' order), costmaps, global planner and trajectory
+// controller.
 //
 // Interfaces as ROS's move_base: action `move_base` (move_base_msgs/MoveBaseAction),
 // `move_base_simple/goal`, `cmd_vel`, `odom` (for the robot's velocity), services `~make_plan`
@@ -20,6 +22,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -45,6 +48,7 @@
 #include "sim_rate.h"
 #include "mbot_slam_navigation/core/global_planner.h"
 #include "mbot_slam_navigation/core/move_base_config.h"
+#include "mbot_slam_navigation/core/move_base_fsm.h"
 #include "mbot_slam_navigation/core/trajectory_controller.h"
 #include "ros_conversions.h"
 
@@ -54,23 +58,6 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Path2 = std::vector<Eigen::Vector2d>;
 using ros_glue::SimRate;
-enum class State { kPlanning, kControlling, kClearing };
-enum class Trigger { kNone, kPlanning, kControlling, kOscillation, kNoProgress };
-
-constexpr double kGoalProgress_m = 0.25;  // the path to the goal this much shorter is progress (progress_timeout)
-
-/// [m] Along `plan` from its point nearest `pose` to its end, plus the way to that point.
-double remainingPath(const Path2& plan, const Eigen::Vector2d& pose) {
-  if (plan.empty()) return std::numeric_limits<double>::infinity();
-  std::size_t nearest = 0;
-  for (std::size_t i = 1; i < plan.size(); ++i) {
-    if ((plan[i] - pose).squaredNorm() < (plan[nearest] - pose).squaredNorm()) nearest = i;
-  }
-  double length = (plan[nearest] - pose).norm();
-  for (std::size_t i = nearest + 1; i < plan.size(); ++i) length += (plan[i] - plan[i - 1]).norm();
-  return length;
-}
-
 std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
 std::string fmt(const char* f, ...) {
   char buf[1024];
@@ -116,6 +103,7 @@ class MoveBase {
     planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);
     service_planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);  // ~make_plan, not racing the loop
     controller_ = std::make_unique<core::TrajectoryController>(config_.local, config_.local_ros, local_->config().footprint);
+    fsm_ = std::make_unique<core::MoveBaseStateMachine>(config_);
 
     cmd_pub_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 1);
     plan_pub_ = pnh.advertise<nav_msgs::Path>(config_.global_ns + "/plan", 1, true);
@@ -347,19 +335,7 @@ class MoveBase {
   }
 
   void reset() {
-    const ros::Time now = ros::Time::now();
-    state_ = State::kPlanning;
-    plan_.clear();
-    new_plan_ = false;
-    last_plan_time_ = ros::Time();
-    last_valid_plan_ = last_valid_control_ = last_oscillation_reset_ = now;
-    oscillation_pose_.reset();
-    planning_retries_ = 0;
-    recovery_index_ = 0;
-    trigger_ = Trigger::kNone;
-    goal_best_m_ = std::numeric_limits<double>::infinity();
-    goal_progress_time_ = now;
-    why_.clear();
+    fsm_->reset(ros::Time::now().toSec());
     controller_->reset();
   }
 
@@ -372,187 +348,92 @@ class MoveBase {
 
   bool framesDiffer() const { return local_->config().global_frame != global_->config().global_frame; }
 
+  /// The node's side of the state machine (core/move_base_fsm.h): tf, costmaps, planners, cmd_vel.
+  class Ports : public core::MoveBasePorts {
+   public:
+    explicit Ports(MoveBase& mb) : mb_(mb) {}
+    std::optional<Vec3> robotPose(std::string& why) override {
+      const auto pose = mb_.global_->lookupRobotPose();
+      if (!pose) why = mb_.global_->tfProblem();
+      return pose;
+    }
+    bool sensorsCurrent(std::string& why) override {
+      const auto [current, stale_why] = mb_.local_->isCurrent();
+      why = stale_why;
+      return current;
+    }
+    bool makePlan(const Vec3& start, const Vec3& goal, Path2& path, std::string& why) override {
+      return mb_.plan(*mb_.planner_, start, goal, path, why);
+    }
+    void planMade(const Path2& path, double goal_yaw) override {
+      mb_.publishPath({&mb_.plan_pub_, &mb_.generic_plan_pub_}, path, mb_.global_->config().global_frame, goal_yaw);
+    }
+    void followPlan(const Path2& path, double goal_yaw) override { mb_.controller_->setPlan(mb_.toLocal(path), goal_yaw); }
+    core::ControlResult computeVelocity() override {
+      const auto local_pose = mb_.framesDiffer() ? mb_.local_->lookupRobotPose() : mb_.global_->lookupRobotPose();
+      core::ControlResult control;
+      if (!local_pose) {
+        control.why = "tf: " + mb_.local_->tfProblem();
+        return control;
+      }
+      auto guard = mb_.local_->lock();
+      return mb_.controller_->compute(mb_.local_->master(), *local_pose, mb_.velocity());
+    }
+    bool goalReached() override { return mb_.controller_->reached(); }
+    void sendVelocity(const Vec3& command) override {
+      geometry_msgs::Twist t;
+      t.linear.x = command.x();
+      t.linear.y = command.y();
+      t.angular.z = command.z();
+      mb_.cmd_pub_.publish(t);
+    }
+    void stop() override { mb_.stop(); }
+    double runRecovery(const core::RecoveryConfig& r) override {
+      mb_.runRecovery(r);
+      return ros::Time::now().toSec();
+    }
+    void feedback(const Vec3& pose) override {
+      move_base_msgs::MoveBaseFeedback feedback;
+      std_msgs::Header header;
+      header.frame_id = mb_.global_->config().global_frame;
+      header.stamp = ros::Time::now();
+      feedback.base_position = poseStamped(header, pose.x(), pose.y(), pose.z());
+      mb_.server_->publishFeedback(feedback);
+    }
+    void controlled() override { mb_.publishLocal(); }
+    void warn(const char* key, const std::string& text, double throttle_s) override {
+      const ros::Time now = ros::Time::now();
+      if (throttle_s > 0) {
+        ros::Time& last = last_warned_[key];
+        if (!last.isZero() && now >= last && (now - last).toSec() < throttle_s) return;
+        last = now;
+      }
+      ROS_WARN("move_base: %s", text.c_str());
+    }
+
+   private:
+    MoveBase& mb_;
+    std::map<std::string, ros::Time> last_warned_;
+  };
+
   /// One control cycle; true when the goal is finished (succeeded or aborted).
   bool cycle(const Vec3& goal) {
-    const ros::Time now = ros::Time::now();
     if (server_reset_pending_) {
       // reset_simulation (or a bag played again): the pose, plan and obstacles of before no longer
       // hold. watchClock() clears the costmaps and restarts the server once this goal has ended.
       return abort(fmt("the clock went back by %.1f s (the simulation was reset?); the costmaps are cleared, send the "
                        "goal again", clock_jump_s_.load()));
     }
-    const auto pose = global_->lookupRobotPose();
-    if (!pose) {
-      stop();
-      const std::string why = "tf: " + global_->tfProblem();
-      ROS_WARN_THROTTLE(2, "move_base: cannot get the robot pose: %s", why.c_str());
-      if ((now - last_valid_control_).toSec() > config_.controller_patience) {
-        return abort(fmt("Robot pose unavailable for more than controller_patience %.1f s (%s)", config_.controller_patience, why.c_str()));
-      }
-      return false;
-    }
-    move_base_msgs::MoveBaseFeedback feedback;
-    std_msgs::Header header;
-    header.frame_id = global_->config().global_frame;
-    header.stamp = now;
-    feedback.base_position = poseStamped(header, pose->x(), pose->y(), pose->z());
-    server_->publishFeedback(feedback);
-
-    if (!oscillation_pose_ || (pose->head<2>() - oscillation_pose_->head<2>()).norm() >= config_.oscillation_distance) {
-      last_oscillation_reset_ = now;
-      oscillation_pose_ = *pose;
-      if (trigger_ == Trigger::kOscillation) recovery_index_ = 0;
-    }
-
-    const auto [current, stale_why] = local_->isCurrent();
-    if (!current) {
-      stop();
-      ROS_WARN_THROTTLE(2, "move_base: sensor data is out of date, not commanding the base for safety: %s", stale_why.c_str());
-      if ((now - last_valid_control_).toSec() > config_.controller_patience) {
-        return abort(fmt("The local costmap was not current for controller_patience %.1f s: %s", config_.controller_patience,
-                         stale_why.c_str()));
-      }
-      return false;
-    }
-
-    const bool replan_due = config_.planner_frequency > 0 && !last_plan_time_.isZero() &&
-                            (now - last_plan_time_).toSec() >= 1.0 / config_.planner_frequency;
-    if (state_ == State::kPlanning || (state_ == State::kControlling && replan_due)) {
-      Path2 path;
-      std::string why;
-      const bool ok = plan(*planner_, *pose, goal, path, why);
-      last_plan_time_ = now;
-      if (ok) {
-        plan_ = path;
-        new_plan_ = true;
-        last_valid_plan_ = now;
-        planning_retries_ = 0;
-        state_ = State::kControlling;
-        publishPath({&plan_pub_, &generic_plan_pub_}, path, global_->config().global_frame, goal.z());
-      } else {
-        why_ = why;
-        ++planning_retries_;
-        if (state_ == State::kControlling) {
-          ROS_WARN("move_base: replanning failed (%s); stopping instead of following the old plan", why.c_str());
-          state_ = State::kPlanning;
-        }
-        stop();
-        ROS_WARN_THROTTLE(2, "move_base: no plan: %s", why.c_str());
-        if ((now - last_valid_plan_).toSec() > config_.planner_patience ||
-            (config_.max_planning_retries >= 0 && planning_retries_ > config_.max_planning_retries)) {
-          state_ = State::kClearing;
-          trigger_ = Trigger::kPlanning;
-        } else {
-          return false;
-        }
-      }
-    }
-
-    if (!plan_.empty()) {
-      const double remaining = remainingPath(plan_, pose->head<2>());
-      if (remaining < goal_best_m_ - kGoalProgress_m) {
-        goal_best_m_ = remaining;
-        goal_progress_time_ = now;
-        if (trigger_ == Trigger::kNoProgress) recovery_index_ = 0;
-      }
-    }
-
-    if (state_ == State::kControlling) {
-      if (new_plan_) {
-        controller_->setPlan(toLocal(plan_), goal.z());
-        new_plan_ = false;
-      }
-      const auto local_pose = framesDiffer() ? local_->lookupRobotPose() : pose;
-      core::ControlResult control;
-      if (!local_pose) {
-        control.why = "tf: " + local_->tfProblem();
-      } else {
-        auto guard = local_->lock();
-        control = controller_->compute(local_->master(), *local_pose, velocity());
-      }
-      if (control.valid && control.footprint_scale < 1.0) {
-        ROS_WARN_THROTTLE(5, "move_base: the robot's footprint touches an obstacle in the local costmap where it stands; "
-                             "moving out with the footprint shrunk to %.0f%%", 100.0 * control.footprint_scale);
-      }
-      if (std::isfinite(control.obstacle_inside_m)) {
-        ROS_WARN_THROTTLE(5, "move_base: an obstacle stands inside the robot's footprint, %.2f m from its centre (a person "
-                             "who walked into it?); only moves that keep away from it", control.obstacle_inside_m);
-      }
-      if (controller_->reached()) {
-        stop();
+    switch (fsm_->cycle(ros::Time::now().toSec(), goal, ports_)) {
+      case core::GoalOutcome::kSucceeded:
         controller_->reset();
         server_->setSucceeded(move_base_msgs::MoveBaseResult(), "Goal reached.");
         ROS_INFO("move_base: goal reached");
         return true;
-      }
-      publishLocal();
-      if (config_.progress_timeout > 0 && (now - goal_progress_time_).toSec() > config_.progress_timeout) {
-        stop();
-        why_ = fmt("the path to the goal has not got %.2f m shorter than %.2f m in progress_timeout %.1f s (something the "
-                   "laser sees from one side only, a person, may stand on the goal)",
-                   kGoalProgress_m, goal_best_m_, config_.progress_timeout);
-        state_ = State::kClearing;
-        trigger_ = Trigger::kNoProgress;
-      } else if (config_.oscillation_timeout > 0 && (now - last_oscillation_reset_).toSec() > config_.oscillation_timeout) {
-        stop();
-        why_ = fmt("moved less than oscillation_distance %.2f m in oscillation_timeout %.1f s", config_.oscillation_distance,
-                   config_.oscillation_timeout);
-        state_ = State::kClearing;
-        trigger_ = Trigger::kOscillation;
-      } else if (control.valid) {
-        geometry_msgs::Twist t;
-        t.linear.x = control.command.x();
-        t.linear.y = control.command.y();
-        t.angular.z = control.command.z();
-        cmd_pub_.publish(t);
-        last_valid_control_ = now;
-        if (trigger_ == Trigger::kControlling) recovery_index_ = 0;
-      } else {
-        why_ = control.why;
-        stop();
-        if ((now - last_valid_control_).toSec() > config_.controller_patience) {
-          state_ = State::kClearing;
-          trigger_ = Trigger::kControlling;
-        } else {
-          // No valid command: plan again from here (ROS does the same).
-          last_valid_plan_ = now;
-          planning_retries_ = 0;
-          state_ = State::kPlanning;
-          return false;
-        }
-      }
-    }
-
-    if (state_ == State::kClearing) {
-      const auto& recoveries = config_.recoveries;
-      if (trigger_ == Trigger::kPlanning && (why_.rfind("goal occupied", 0) == 0 || why_.rfind("goal off the costmap", 0) == 0)) {
-        // Turning or backing up cannot free a goal cell or bring it onto the map; only clearing
-        // the costmaps might, so the motion recoveries are skipped.
-        while (recovery_index_ < recoveries.size() && recoveries[recovery_index_].kind != core::RecoveryKind::kClearCostmap) {
-          ++recovery_index_;
-        }
-      }
-      const char* trigger_text = trigger_ == Trigger::kPlanning      ? "no valid plan"
-                                 : trigger_ == Trigger::kControlling ? "no valid control"
-                                 : trigger_ == Trigger::kNoProgress  ? "no progress towards the goal"
-                                                                     : "oscillating";
-      if (config_.recovery_behavior_enabled && recovery_index_ < recoveries.size()) {
-        const auto& r = recoveries[recovery_index_];
-        ROS_WARN("move_base: %s (%s); running recovery behaviour %s", trigger_text, why_.c_str(), r.name.c_str());
-        runRecovery(r);
-        ++recovery_index_;
-        last_oscillation_reset_ = last_valid_plan_ = last_valid_control_ = goal_progress_time_ = ros::Time::now();
-        planning_retries_ = 0;
-        state_ = State::kPlanning;
-        return false;
-      }
-      const char* text = trigger_ == Trigger::kPlanning ? "Failed to find a valid plan. Even after executing recovery behaviors."
-                         : trigger_ == Trigger::kControlling
-                             ? "Failed to find a valid control. Even after executing recovery behaviors."
-                         : trigger_ == Trigger::kNoProgress
-                             ? "Robot is making no progress towards the goal. Even after executing recovery behaviors."
-                             : "Robot is oscillating. Even after executing recovery behaviors.";
-      return abort(std::string(text) + " Last reason: " + why_);
+      case core::GoalOutcome::kAborted:
+        return abort(fsm_->abortText());
+      case core::GoalOutcome::kActive:
+        break;
     }
     return false;
   }
@@ -738,18 +619,9 @@ class MoveBase {
       heartbeat_pub_;
   ros::Subscriber odom_sub_, simple_goal_sub_;
   ros::ServiceServer make_plan_srv_, clear_srv_;
-  // The goal's state (the action thread only).
-  State state_ = State::kPlanning;
-  Path2 plan_;
-  bool new_plan_ = false;
-  ros::Time last_plan_time_, last_valid_plan_, last_valid_control_, last_oscillation_reset_;
-  ros::Time goal_progress_time_;  // when the path to the goal last got kGoalProgress_m shorter
-  double goal_best_m_ = std::numeric_limits<double>::infinity();  // [m] its shortest so far
-  std::optional<Vec3> oscillation_pose_;
-  int planning_retries_ = 0;
-  std::size_t recovery_index_ = 0;
-  Trigger trigger_ = Trigger::kNone;
-  std::string why_;
+  // The goal's state machine (the action thread only).
+  std::unique_ptr<core::MoveBaseStateMachine> fsm_;
+  Ports ports_{*this};
 };
 
 }  // namespace

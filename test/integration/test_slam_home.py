@@ -83,8 +83,9 @@ class SlamHomeTest(unittest.TestCase):
 
     def test_a_bad_parameter_stops_the_node_with_its_name(self):
         for arg, message in (('_backend:=particles',
-                              "~backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got 'particles'"),
-                             ('_scan_queue_size:=0', '~scan_queue_size must be at least 1')):
+                              "/param_check/backend must be 'graph' (pose graph) or 'rbpf' (particle filter), got "
+                              "'particles'"),
+                             ('_scan_queue_size:=0', '/param_check/scan_queue_size must be >= 1, got 0')):
             with self.subTest(arg=arg):
                 out = subprocess.run(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=param_check', arg,
                                       'scan:=/param_check/scan', 'map:=/param_check/map',

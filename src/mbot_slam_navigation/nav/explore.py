@@ -518,13 +518,20 @@ class Explore:
                 # them (one may fail and leave its frontier to this robot).
                 rospy.loginfo_throttle(30.0, 'explore: %d frontier(s) blacklisted for now, %d left to teammates; '
                                        'waiting' % (waiting, claimed))
+            elif stats.get('robot_outside'):
+                # Not done: the robot stands beyond the global costmap, which grows with the map a
+                # cycle or two later.
+                rospy.loginfo_throttle(30.0, 'explore: the robot is outside the global costmap (it grows with the '
+                                       'map); waiting')
             elif reachable_m2 < BOXED_IN_M2:
                 # Not done: the robot is boxed in on its costmap (an obstacle seen beside it, a stale
                 # costmap). Clearing the costmaps frees it if the obstacle is gone; if not within
                 # progress_timeout, it backs out along its own path; if it cannot, it is stuck.
                 if boxed_since is None:
+                    # Usually an obstacle the laser saw beside the robot, gone after clearing: said
+                    # as information; a robot still boxed in after progress_timeout is warned about.
                     boxed_since = now
-                    rospy.logwarn('explore: the robot can reach only %.1f m^2 on the global costmap; clearing the '
+                    rospy.loginfo('explore: the robot can reach only %.1f m^2 on the global costmap; clearing the '
                                   'costmaps' % reachable_m2)
                     self.clear_costmaps()
                 elif now - boxed_since >= self.state.progress_timeout:

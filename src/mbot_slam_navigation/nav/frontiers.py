@@ -205,6 +205,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     """
     rr, rc = costmap.cell_of(robot[0], robot[1])
     if not costmap.inside(rr, rc):
+        if stats is not None:
+            stats['robot_outside'] = True  # the costmap has not grown to the robot yet
         return []
     open_cells = passable(costmap, m, occupied_min)
     cost = costmap.data.astype(np.int16)

@@ -1,0 +1,250 @@
+// move_base's state machine on a fake world and a fake clock: patience, retries, oscillation,
+// progress, the recoveries in order and what resets them, and the abort texts users read.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "mbot_slam_navigation/core/move_base_fsm.h"
+
+namespace {
+
+using mbot::core::ControlResult;
+using mbot::core::GoalOutcome;
+using mbot::core::MoveBaseConfig;
+using mbot::core::MoveBaseState;
+using mbot::core::MoveBaseStateMachine;
+using mbot::core::ParamValue;
+using mbot::core::RecoveryConfig;
+using mbot::core::RecoveryTrigger;
+
+// A robot on a straight line: it moves by `speed` times the commanded vx each cycle; plans and
+// controls succeed or fail as told.
+struct FakeWorld : mbot::core::MoveBasePorts {
+  double now = 0.0;
+  double dt = 0.1;                     // [s] the control period
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();
+  bool pose_ok = true, current = true, plan_ok = true, control_ok = true, reached = false;
+  double speed = 1.0;                  // how much of the command the robot achieves
+  std::string plan_why = "no path";
+  double recovery_s = 3.0;             // [s] each recovery takes
+  std::vector<std::string> recoveries_run, warnings;
+  int plans = 0, follows = 0, stops = 0;
+  Eigen::Vector3d last_command = Eigen::Vector3d::Zero();
+
+  std::optional<Eigen::Vector3d> robotPose(std::string& why) override {
+    if (!pose_ok) why = "no transform";
+    return pose_ok ? std::optional<Eigen::Vector3d>(pose) : std::nullopt;
+  }
+  bool sensorsCurrent(std::string& why) override {
+    if (!current) why = "scan not updated for 3 s";
+    return current;
+  }
+  bool makePlan(const Eigen::Vector3d& start, const Eigen::Vector3d& goal, std::vector<Eigen::Vector2d>& path,
+                std::string& why) override {
+    ++plans;
+    if (!plan_ok) {
+      why = plan_why;
+      return false;
+    }
+    path.clear();  // a straight line, a point every 0.1 m
+    const double length = (goal - start).head<2>().norm();
+    for (double d = 0.0; d < length; d += 0.1) path.push_back(start.head<2>() + (goal - start).head<2>() * (d / length));
+    path.push_back(goal.head<2>());
+    return true;
+  }
+  void planMade(const std::vector<Eigen::Vector2d>&, double) override {}
+  void followPlan(const std::vector<Eigen::Vector2d>&, double) override { ++follows; }
+  ControlResult computeVelocity() override {
+    ControlResult c;
+    c.valid = control_ok;
+    if (c.valid) c.command = Eigen::Vector3d(0.3, 0.0, 0.0);
+    else c.why = "no valid trajectory";
+    return c;
+  }
+  bool goalReached() override { return reached; }
+  void sendVelocity(const Eigen::Vector3d& command) override {
+    last_command = command;
+    pose.x() += speed * command.x() * dt;
+  }
+  void stop() override { ++stops; }
+  double runRecovery(const RecoveryConfig& r) override {
+    recoveries_run.push_back(r.name);
+    now += recovery_s;
+    return now;
+  }
+  void warn(const char*, const std::string& text, double) override { warnings.push_back(text); }
+};
+
+MoveBaseConfig defaults() { return mbot::core::readMoveBaseConfig(ParamValue::ofMap(), "/move_base", nullptr, 0.2); }
+
+// Runs cycles until the goal ends or `max_s` simulated seconds pass.
+GoalOutcome run(MoveBaseStateMachine& fsm, FakeWorld& w, const Eigen::Vector3d& goal, double max_s) {
+  const double end = w.now + max_s;
+  while (w.now < end) {
+    const GoalOutcome o = fsm.cycle(w.now, goal, w);
+    if (o != GoalOutcome::kActive) return o;
+    w.now += w.dt;
+  }
+  return GoalOutcome::kActive;
+}
+
+TEST(MoveBaseStateMachine, PlansThenControlsThenSucceeds) {
+  MoveBaseStateMachine fsm(defaults());
+  FakeWorld w;
+  fsm.reset(0.0);
+  EXPECT_EQ(fsm.cycle(w.now, {5, 0, 0}, w), GoalOutcome::kActive);
+  EXPECT_EQ(fsm.state(), MoveBaseState::kControlling);
+  EXPECT_EQ(w.plans, 1);
+  EXPECT_EQ(w.follows, 1);
+  EXPECT_DOUBLE_EQ(w.last_command.x(), 0.3);
+  w.reached = true;
+  EXPECT_EQ(fsm.cycle(w.now + 0.1, {5, 0, 0}, w), GoalOutcome::kSucceeded);
+  EXPECT_TRUE(w.recoveries_run.empty());
+}
+
+TEST(MoveBaseStateMachine, NoPlanWithinPlannerPatienceRunsTheRecoveriesInOrderThenAborts) {
+  MoveBaseConfig c = defaults();
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  w.plan_ok = false;
+  fsm.reset(0.0);
+  // ROS's defaults: planner_patience 5 s; then conservative_reset, rotate_recovery, back_up,
+  // aggressive_reset, rotate_recovery, each followed by planner_patience of planning again.
+  EXPECT_EQ(run(fsm, w, {5, 0, 0}, 200.0), GoalOutcome::kAborted);
+  const std::vector<std::string> expected = {"conservative_reset", "rotate_recovery", "back_up", "aggressive_reset",
+                                             "rotate_recovery"};
+  EXPECT_EQ(w.recoveries_run, expected);
+  EXPECT_EQ(fsm.abortText(), "Failed to find a valid plan. Even after executing recovery behaviors. Last reason: no path");
+  // each recovery came after more than planner_patience without a plan
+  EXPECT_GT(w.now, c.recoveries.size() * (c.planner_patience + w.recovery_s));
+  EXPECT_LT(w.now, c.recoveries.size() * (c.planner_patience + w.recovery_s) + c.planner_patience + 1.0);
+}
+
+TEST(MoveBaseStateMachine, AnOccupiedGoalSkipsTheMotionRecoveries) {
+  MoveBaseStateMachine fsm(defaults());
+  FakeWorld w;
+  w.plan_ok = false;
+  w.plan_why = "goal occupied: the goal cell is lethal";
+  fsm.reset(0.0);
+  EXPECT_EQ(run(fsm, w, {5, 0, 0}, 200.0), GoalOutcome::kAborted);
+  const std::vector<std::string> expected = {"conservative_reset", "aggressive_reset"};
+  EXPECT_EQ(w.recoveries_run, expected);
+}
+
+TEST(MoveBaseStateMachine, MaxPlanningRetriesEndsPlanningBeforePatience) {
+  MoveBaseConfig c = defaults();
+  c.max_planning_retries = 2;
+  c.recovery_behavior_enabled = false;
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  w.plan_ok = false;
+  fsm.reset(0.0);
+  EXPECT_EQ(run(fsm, w, {5, 0, 0}, 10.0), GoalOutcome::kAborted);
+  EXPECT_EQ(w.plans, 3);  // the first try and 2 retries
+  EXPECT_TRUE(w.recoveries_run.empty());
+}
+
+TEST(MoveBaseStateMachine, NoValidControlReplansUntilControllerPatienceThenRecovers) {
+  MoveBaseConfig c = defaults();
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  fsm.reset(0.0);
+  fsm.cycle(w.now, {5, 0, 0}, w);
+  w.control_ok = false;
+  w.now += w.dt;
+  const int plans_before = w.plans;
+  // within controller_patience (15 s) a failed control plans again, no recovery
+  while (w.now < c.controller_patience - 1.0) {
+    ASSERT_EQ(fsm.cycle(w.now, {5, 0, 0}, w), GoalOutcome::kActive);
+    w.now += w.dt;
+  }
+  EXPECT_GT(w.plans, plans_before + 10);
+  EXPECT_TRUE(w.recoveries_run.empty());
+  while (w.recoveries_run.empty() && w.now < c.controller_patience + 2.0) {
+    fsm.cycle(w.now, {5, 0, 0}, w);
+    w.now += w.dt;
+  }
+  ASSERT_EQ(w.recoveries_run.size(), 1u);
+  EXPECT_EQ(fsm.trigger(), RecoveryTrigger::kControlling);
+  // a valid command afterwards starts the recoveries from the first again
+  w.control_ok = true;
+  fsm.cycle(w.now, {5, 0, 0}, w);
+  w.now += w.dt;
+  fsm.cycle(w.now, {5, 0, 0}, w);
+  EXPECT_EQ(fsm.recoveryIndex(), 0u);
+}
+
+TEST(MoveBaseStateMachine, ARobotThatDoesNotMoveOscillationDistanceRecoversAfterOscillationTimeout) {
+  MoveBaseConfig c = defaults();
+  c.progress_timeout = 0.0;  // oscillation alone
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  w.speed = 0.0;  // commands are valid, the robot does not move (wheels spinning, rocking in place)
+  fsm.reset(0.0);
+  while (w.recoveries_run.empty() && w.now < 60.0) {
+    fsm.cycle(w.now, {5, 0, 0}, w);
+    w.now += w.dt;
+  }
+  ASSERT_EQ(w.recoveries_run.size(), 1u);
+  EXPECT_EQ(fsm.trigger(), RecoveryTrigger::kOscillation);
+  EXPECT_NEAR(w.now - w.recovery_s, c.oscillation_timeout, 0.25);
+  EXPECT_EQ(run(fsm, w, {5, 0, 0}, 300.0), GoalOutcome::kAborted);
+  EXPECT_EQ(fsm.abortText().rfind("Robot is oscillating.", 0), 0u) << fsm.abortText();
+}
+
+TEST(MoveBaseStateMachine, DrivingAboutWithoutGettingNearerEndsAfterProgressTimeout) {
+  MoveBaseConfig c = defaults();
+  c.oscillation_timeout = 0.0;
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  w.speed = 0.0;
+  fsm.reset(0.0);
+  EXPECT_EQ(run(fsm, w, {5, 0, 0}, 1000.0), GoalOutcome::kAborted);
+  EXPECT_EQ(fsm.trigger(), RecoveryTrigger::kNoProgress);
+  EXPECT_EQ(w.recoveries_run.size(), c.recoveries.size());
+  EXPECT_NE(fsm.abortText().find("progress_timeout 60.0 s"), std::string::npos) << fsm.abortText();
+}
+
+TEST(MoveBaseStateMachine, SlowButSteadyProgressRunsNoRecovery) {
+  MoveBaseStateMachine fsm(defaults());
+  FakeWorld w;
+  w.speed = 0.15;  // 4.5 cm/s: oscillation_distance in 11 s (< 20 s), 0.25 m nearer in 6 s (< 60 s)
+  fsm.reset(0.0);
+  EXPECT_EQ(run(fsm, w, {50, 0, 0}, 120.0), GoalOutcome::kActive);
+  EXPECT_TRUE(w.recoveries_run.empty());
+}
+
+TEST(MoveBaseStateMachine, WithoutAPoseOrCurrentSensorsItStopsAndAbortsAfterControllerPatience) {
+  MoveBaseConfig c = defaults();
+  for (int stale = 0; stale < 2; ++stale) {
+    MoveBaseStateMachine fsm(c);
+    FakeWorld w;
+    (stale ? w.current : w.pose_ok) = false;
+    fsm.reset(0.0);
+    EXPECT_EQ(run(fsm, w, {5, 0, 0}, 30.0), GoalOutcome::kAborted);
+    EXPECT_NEAR(w.now, c.controller_patience, 0.2);
+    EXPECT_EQ(w.last_command.x(), 0.0);
+    EXPECT_GT(w.stops, 100);
+    EXPECT_NE(fsm.abortText().find(stale ? "not current" : "Robot pose unavailable"), std::string::npos);
+  }
+}
+
+TEST(MoveBaseStateMachine, AFailedReplanWhileMovingStopsTheRobot) {
+  MoveBaseConfig c = defaults();
+  c.planner_frequency = 1.0;
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  fsm.reset(0.0);
+  run(fsm, w, {50, 0, 0}, 1.05);
+  EXPECT_EQ(fsm.state(), MoveBaseState::kControlling);
+  w.plan_ok = false;
+  const int stops = w.stops;
+  run(fsm, w, {50, 0, 0}, 1.0);
+  EXPECT_EQ(fsm.state(), MoveBaseState::kPlanning);
+  EXPECT_GT(w.stops, stops);
+  ASSERT_FALSE(w.warnings.empty());
+  EXPECT_NE(w.warnings.front().find("stopping instead of following the old plan"), std::string::npos);
+}
+
+}  // namespace
