@@ -152,7 +152,8 @@ GoalOutcome MoveBaseStateMachine::controlStep(double now, const Eigen::Vector3d&
   }
   const ControlResult control = ports.computeVelocity();
   if (control.valid && control.footprint_scale < 1.0) {
-    ports.warn("footprint",
+    // Beside a wall the footprint can touch an inflated obstacle cell; moving out is routine.
+    ports.info("footprint",
                fmt("the robot's footprint touches an obstacle in the local costmap where it stands; moving out with the "
                    "footprint shrunk to %.0f%%",
                    100.0 * control.footprint_scale),

@@ -402,18 +402,24 @@ class MoveBase {
     }
     void controlled() override { mb_.publishLocal(); }
     void warn(const char* key, const std::string& text, double throttle_s) override {
-      const ros::Time now = ros::Time::now();
-      if (throttle_s > 0) {
-        ros::Time& last = last_warned_[key];
-        if (!last.isZero() && now >= last && (now - last).toSec() < throttle_s) return;
-        last = now;
-      }
-      ROS_WARN("move_base: %s", text.c_str());
+      if (due(key, throttle_s)) ROS_WARN("move_base: %s", text.c_str());
+    }
+    void info(const char* key, const std::string& text, double throttle_s) override {
+      if (due(key, throttle_s)) ROS_INFO("move_base: %s", text.c_str());
     }
 
    private:
+    bool due(const char* key, double throttle_s) {
+      if (throttle_s <= 0) return true;
+      const ros::Time now = ros::Time::now();
+      ros::Time& last = last_said_[key];
+      if (!last.isZero() && now >= last && (now - last).toSec() < throttle_s) return false;
+      last = now;
+      return true;
+    }
+
     MoveBase& mb_;
-    std::map<std::string, ros::Time> last_warned_;
+    std::map<std::string, ros::Time> last_said_;
   };
 
   /// One control cycle; true when the goal is finished (succeeded or aborted).

@@ -49,6 +49,10 @@ class MoveBasePorts {
   virtual void controlled() {}
   /// A warning; `key` names its kind, `throttle_s` > 0 asks to repeat it at most that often.
   virtual void warn(const char* key, const std::string& text, double throttle_s) = 0;
+  /// Information: something handled as a matter of course (same arguments).
+  virtual void info(const char* key, const std::string& text, double throttle_s) {
+    (void)key, (void)text, (void)throttle_s;
+  }
 };
 
 enum class MoveBaseState { kPlanning, kControlling, kClearing };

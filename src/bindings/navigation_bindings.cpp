@@ -1,10 +1,8 @@
 // Bindings of move_base's configuration and costmap layers (the same C++ the roscpp move_base
 // runs), for the Python nodes that read parameters and for the tests.
-#include <pybind11/eigen.h>
+#include "bindings.h"
+
 #include <pybind11/functional.h>
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
-#include <pybind11/stl.h>
 
 #include "mbot_slam_navigation/core/layered_costmap.h"
 #include "mbot_slam_navigation/core/move_base_config.h"
@@ -12,7 +10,9 @@
 #include "mbot_slam_navigation/core/slam_config.h"
 #include "mbot_slam_navigation/core/trajectory_controller.h"
 
-namespace py = pybind11;
+namespace mbot {
+namespace bindings {
+
 using namespace mbot::core;
 
 namespace {
@@ -269,3 +269,6 @@ void bindNavigation(py::module& m) {
   }, "slam_gmapping's parameters (core/slam_config.h) and the keys no one reads.", py::arg("values"), py::arg("ns"),
      py::arg("warn"), py::arg("default_max_range"));
 }
+
+}  // namespace bindings
+}  // namespace mbot

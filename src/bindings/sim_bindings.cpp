@@ -1,0 +1,81 @@
+// Bindings of the simulator's world (shapes, lasers) and its differential drive.
+#include "bindings.h"
+
+#include <tuple>
+
+#include "mbot_slam_navigation/core/diff_drive.h"
+#include "mbot_slam_navigation/core/world2d.h"
+
+namespace mbot {
+namespace bindings {
+
+using namespace mbot::core;
+
+void bindSimulation(py::module& m) {
+  m.def("_point_polygon_distance", &mbot::core::pointPolygonDistance, py::arg("point"), py::arg("polygon"),
+        "Distance [m] from a point to a solid polygon (0 inside).");
+
+  py::class_<World2D>(m, "_World2D")
+      .def(py::init<double>(), py::arg("bucket_size") = 0.5)
+      .def("add_box", &World2D::addBox, py::arg("center"), py::arg("yaw"), py::arg("size_x"), py::arg("size_y"))
+      .def("add_polygon", &World2D::addPolygon, py::arg("polygon"))
+      .def("add_cylinder", &World2D::addCylinder, py::arg("center"), py::arg("radius"))
+      .def("add_segment", &World2D::addSegment, py::arg("a"), py::arg("b"))
+      .def("set_dynamic_polygons", &World2D::setDynamicPolygons, py::arg("polygons"))
+      .def("set_dynamic_circles", &World2D::setDynamicCircles, py::arg("circles"))
+      .def("distance_to_dynamic_polygons", &World2D::distanceToDynamicPolygons, py::arg("point"))
+      .def("cast_ray", &World2D::castRay, py::arg("origin"), py::arg("angle"), py::arg("max_range"),
+           py::arg("skip_dynamic") = -1)
+      .def("overlaps", &World2D::overlaps, py::arg("polygon"), py::arg("skip_dynamic") = -1)
+      .def_property_readonly("segment_count", &World2D::segmentCount)
+      .def_property_readonly("circle_count", &World2D::circleCount);
+
+  // A laser: owns its random generator so that a seeded simulation repeats exactly.
+  struct LaserRng {
+    std::mt19937 rng;
+  };
+  py::class_<LaserRng>(m, "_Rng").def(py::init([](unsigned seed) { return LaserRng{std::mt19937(seed)}; }));
+  m.def(
+      "_cast_scan",
+      [](const World2D& world, const Eigen::Vector3d& pose, double angle_min, double angle_increment, int beams,
+         double range_min, double range_max, double noise, double range_resolution, LaserRng& rng, int skip_dynamic) {
+        py::array_t<float> out(beams);
+        float* o = out.mutable_data();
+        {
+          py::gil_scoped_release release;
+          world.castScan(pose, angle_min, angle_increment, beams, range_min, range_max, noise, range_resolution,
+                         rng.rng, o, skip_dynamic);
+        }
+        return out;
+      },
+      py::arg("world"), py::arg("pose"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("beams"),
+      py::arg("range_min"), py::arg("range_max"), py::arg("noise_stddev"), py::arg("range_resolution"),
+      py::arg("rng"), py::arg("skip_dynamic") = -1);
+
+  py::class_<DiffDriveParams>(m, "_DiffDriveParams")
+      .def(py::init<>())
+      .def_readwrite("wheel_separation", &DiffDriveParams::wheel_separation_m)
+      .def_readwrite("wheel_diameter", &DiffDriveParams::wheel_diameter_m)
+      .def_readwrite("wheel_acceleration", &DiffDriveParams::wheel_acceleration_mps2)
+      .def_readwrite("cmd_timeout", &DiffDriveParams::cmd_timeout_s)
+      .def_readwrite("slip_stddev", &DiffDriveParams::slip_stddev)
+      .def_readwrite("odometry_from_world", &DiffDriveParams::odometry_from_world)
+      .def("validate", &DiffDriveParams::validate);
+
+  py::class_<DiffDrive>(m, "_DiffDrive")
+      .def(py::init<const DiffDriveParams&, const Polygon&, const Eigen::Vector3d&, unsigned>(), py::arg("params"),
+           py::arg("footprint"), py::arg("spawn_pose"), py::arg("seed"))
+      .def("command", &DiffDrive::command, py::arg("v"), py::arg("w"), py::arg("now"))
+      .def("step", &DiffDrive::step, py::arg("dt"), py::arg("now"), py::arg("world"), py::arg("self_index") = -1)
+      .def("set_pose", &DiffDrive::setPose)
+      .def("reset_odometry", &DiffDrive::resetOdometry)
+      .def_property_readonly("pose", &DiffDrive::pose)
+      .def_property_readonly("odom_pose", &DiffDrive::odomPose)
+      .def_property_readonly("linear_velocity", &DiffDrive::linearVelocity)
+      .def_property_readonly("angular_velocity", &DiffDrive::angularVelocity)
+      .def_property_readonly("wheel_angles", &DiffDrive::wheelAngles)
+      .def("footprint_in_world", &DiffDrive::footprintInWorld);
+}
+
+}  // namespace bindings
+}  // namespace mbot
