@@ -230,7 +230,7 @@ def main():
                 write_scan_bag(scans, bag)
             times = np.array([s.time for s in scans])
             # The same scans as the bag carries them (a LaserScan's angles are float32: a change of
-            # 1e-7 rad that alone moved ACES's online figure from 0.059 to 0.072 m on 2026-11-24).
+            # 1e-7 rad alone once moved ACES's online figure from 0.059 to 0.072 m).
             as_bag = [replace(s, angle_min=float(np.float32(s.angle_min)),
                               angle_increment=float(np.float32(s.angle_increment))) for s in scans]
             for backend in backends:

@@ -1,8 +1,8 @@
 """A rospy subscription that reads its connections at most every `period` seconds of wall time.
 
 rospy gives each publisher connection a thread that blocks on its socket and wakes for every
-message that arrives. What the wake-up costs does not depend on the message: measured 2026-11-28
-in the explorer, with the simulation at about 6x real time, the /clock thread (100 messages a
+message that arrives. What the wake-up costs does not depend on the message: in the explorer,
+with the simulation at about 6x real time, the /clock thread (100 messages a
 simulated second, 600 a wall second) was 34% of the node's CPU and the /tf threads (87 a simulated
 second) 24%, while the explorer wants the time and the robot's pose a few times a second. Moving
 them to a roscpp node in the same process did not help: its threads took more than the rospy

@@ -3,9 +3,8 @@
 A rospy node that wants the robot's pose a few times a second (explore, random_navigation) pays,
 with tf2_ros.TransformListener, for deserializing every /tf message and inserting it into its
 buffer, in Python, on arrival: in the simulated home that is 87 messages a simulated second
-(measured 2026-11-27: simulator 50, the URDF's odometry rate; SLAM 27; robot_state_publisher 10),
-and it was the explorer's largest cost after the /clock thread (measured 2026-11-25: 1.7 of 5.6
-CPU s of a home exploration). Even raw, the subscription adds half as much again to what an idle
+(the simulator 50, the URDF's odometry rate; SLAM 27; robot_state_publisher 10), and it was the
+explorer's largest cost after the /clock thread (1.7 of 5.6 CPU s of a home exploration). Even raw, the subscription adds half as much again to what an idle
 rospy node pays for /clock (0.0039 on 0.0074 CPU s per simulated s; bench/rospy_floor.py).
 
 This buffer subscribes to /tf as rospy.AnyMsg, so a message arrives as its raw bytes and is only

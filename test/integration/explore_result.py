@@ -22,7 +22,7 @@ def wait_for_report(artifact_name: str, first_timeout: float = 120.0, end_timeou
     # every message: the topic is latched, so each new subscription got the latched False at once
     # and subscribed again, thousands of times a run, and the explorer's publisher threads took
     # more CPU than its exploring (0.033-0.044 CPU s per simulated s in this rostest against
-    # 0.014 in bench_explore.py, measured 2026-11-28). Watched (topic_watch), as the explorer's
+    # 0.014 in bench_explore.py). Watched (topic_watch), as the explorer's
     # own inputs are: rospy can lose a publisher that registers while the subscriber does.
     heard, done = threading.Event(), threading.Event()
 

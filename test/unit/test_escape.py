@@ -1,11 +1,11 @@
-"""The explorer's way out for a stuck robot (nav/escape.py) and its watches (nav/frontiers.py)."""
+"""The explorer's way out for a stuck robot (nav/escape.py) and its watches (nav/explore_state.py)."""
 import math
 
 import numpy as np
 import pytest
 
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
-from mbot_slam_navigation.nav.frontiers import MotionWatch, Plateau
+from mbot_slam_navigation.nav.explore_state import MotionWatch, Plateau
 
 
 def test_backtrack_target_walks_back_along_the_driven_path():

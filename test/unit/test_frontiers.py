@@ -1,4 +1,5 @@
-"""Frontier search and the explorer's decisions, ROS-free (mbot_slam_navigation.nav.frontiers)."""
+"""Frontier search and the explorer's decisions, ROS-free (nav/frontiers.py, nav/tour.py,
+nav/explore_state.py, nav/team.py)."""
 import math
 
 import cv2
@@ -6,8 +7,10 @@ import numpy as np
 import pytest
 
 from mbot_slam_navigation import _core
-from mbot_slam_navigation.nav.frontiers import (ExploreState, Frontier, GivenUp, GoalFields, Grid, Teammate, frontier_groups,
-                                                rank_frontiers, share_out, tour_order, yields_goal)
+from mbot_slam_navigation.nav.explore_state import ExploreState
+from mbot_slam_navigation.nav.frontiers import Frontier, GivenUp, Grid, frontier_groups, rank_frontiers
+from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
+from mbot_slam_navigation.nav.tour import GoalFields, tour_order
 
 RES = 0.05
 

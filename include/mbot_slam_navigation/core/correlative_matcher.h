@@ -4,8 +4,8 @@
 // of reference points (earlier scans): exp(-d^2 / (2 sigma^2)) of the distance d to the nearest
 // reference point, stored as 0..65535 (Olson, "Real-Time Correlative Scan Matching", ICRA 2009,
 // stores 0..255: then every cell within 0.066 sigma of a reference point, 5 mm for a 0.075 m
-// kernel, holds the same 255, and 20 recorded large-floor runs replayed twice came out at or above
-// 99% walls in 36 of 40 maps, the worst 91.9%; with 16 bits 38 of 40, the worst 97.8%).
+// kernel, holds the same 255, too coarse to tell poses apart near the surface; 16 bits made
+// fewer bent maps of the large floor, docs/slam.md).
 // The score of a pose is the mean of that value over the scan's points, in [0, 1].
 //
 // matchBranchAndBound() finds the best-scoring pose in a window (x, y within +-linear, yaw within

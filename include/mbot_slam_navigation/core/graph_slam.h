@@ -76,11 +76,12 @@
 namespace mbot {
 namespace core {
 
+// The parameters' ROS names, units and meanings are in slam_config.cpp (the reader) and on the
+// reference page docs/nodes/slam_gmapping.md; here, what each does inside the graph and why its
+// default is what it is. docs/slam.md has the measurements behind the defaults.
 struct GraphSlamParams {
-  /// [m] `linearUpdate`: a node every this much travel. Half gmapping's 1 m (the rbpf keeps that):
-  /// the scan that the next scans are tracked against is then at most 0.5 m behind them, and
-  /// ACES's pose as published drifted less before its first loop closed (online 0.044-0.055 m over
-  /// 5 draws with local_map_nodes 40, against 0.060-0.104 m with 1 m and 20 nodes).
+  /// [m] `linearUpdate`: a node every this much travel. Half gmapping's 1 m (the rbpf keeps that),
+  /// so that the scan the next scans are tracked against is at most 0.5 m behind them.
   double linear_update = 0.5;
   double angular_update = 0.5;      ///< [rad] `angularUpdate`
   double temporal_update = -1.0;    ///< [s] `temporalUpdate`; < 0 disables
@@ -92,12 +93,9 @@ struct GraphSlamParams {
   double match_max_range = 30.0;    ///< [m] returns farther than this are not matched (`~match_max_range`)
   double match_sigma = 0.075;       ///< [m] likelihood kernel of the loop-closure submaps (`~match_sigma`)
   /// [m] likelihood kernel of the local map that every scan is tracked in (`~local_match_sigma`);
-  /// <= 0: match_sigma. On 14 recorded large-floor runs with closures off, 0.04 left tracking's
-  /// heading within 0.23-0.54 degrees (0.075: 0.38-1.64) and the maps' walls at a mean of 97.0%
-  /// (85.5%); with closures on the maps came out no better (97.7% against 98.5%), so the default stays.
+  /// <= 0: match_sigma. A narrower kernel holds the heading better but did not make better maps.
   double local_match_sigma = -1.0;
-  /// Nodes in the local map (`~local_map_nodes`): 40 at 0.5 m keep the 20 m of travel that 20 at
-  /// 1 m held (20 at 0.5 m, 10 m: ACES online 0.051-0.055 m; 40 at 1 m once 0.066 m).
+  /// Nodes in the local map (`~local_map_nodes`): 40 at 0.5 m keep 20 m of travel to track against.
   int local_map_nodes = 40;
   /// [m] +- x, y around the odometry prediction (`~local_search_window`); the least window when it
   /// widens with local_search_sigmas.
@@ -105,21 +103,18 @@ struct GraphSlamParams {
   /// The window follows odometry's record (`~local_search_sigmas`): this many times r, the root
   /// mean square of how far the best match moved the prediction over the last 200 scans, in every
   /// direction (local_prior_points counts only those the matches pinned), within
-  /// [local_search_window, local_search_max_window]. Odometry that
-  /// slips needs a window that its worst steps fit in: FR079's doorway turns are up to 0.16 m a scan
-  /// off (r 24 mm) and with 0.15 m its map broke in some runs, with 0.25 m in none; the
-  /// simulator's (r 3-4 mm) keeps 0.15 m, where a wider window let the tracked pose slip along a
-  /// corridor. 0 keeps local_search_window throughout.
+  /// [local_search_window, local_search_max_window]. Odometry that slips needs a window its worst
+  /// steps fit in; good odometry keeps a narrow one, where a wider window lets the tracked pose slip
+  /// along a corridor. 0 keeps local_search_window throughout.
   double local_search_sigmas = 10.0;
   double local_search_max_window = 0.3;  ///< [m] (`~local_search_max_window`)
   double local_search_angle = 0.15; ///< [rad] +- yaw (`~local_search_angle`)
   double local_min_score = 0.25;    ///< below: keep the odometry prediction (`~local_min_score`)
-  /// The match climbed from the odometry prediction, held to it by `local_prior_weight`, is kept
+  /// The match climbed from the odometry prediction, held to it by the prior's weight, is kept
   /// when it scores within this fraction of the best match in the window (`~local_prior_margin`):
   /// where the scan does not fix the pose (along a corridor) the best score is one of many nearly
   /// equal ones, and the map, seen from behind the robot, scores a little higher the farther back
-  /// the scan is put; taking it, a gtest corridor without features held the pose where it started
-  /// while the robot drove 18 m. 0 always takes the best.
+  /// the scan is put. 0 always takes the best.
   double local_prior_margin = 0.03;
   /// [1/m^2] score lost per square metre away from the prediction in that climb
   /// (`~local_prior_weight`), while local_prior_points is 0 or fewer than 50 scans were tracked.
@@ -130,45 +125,34 @@ struct GraphSlamParams {
   /// counted as N independent returns), kept within [local_prior_weight, 5000]. r is measured only
   /// along the directions each match pinned (its score curves down there as if a tenth of the
   /// returns lay on surfaces square to it; scoreCurvature): along a plain corridor or one wall the
-  /// best match lies anywhere in the window, and counted, that made good odometry look bad (a
-  /// gtest's 40 m corridor came out 8.7% short with exact odometry, 0.004% so). Where odometry is
-  /// good the prior holds what the scan says little of, and with bias (along a corridor: an office
-  /// run's 25 m corridor came out 0.6% short with the fixed 5.0; the simulator's r is 3-4 mm, a
-  /// weight of 200-350); where it slips (the Radish logs' r of 23-33 mm) the weight stays near 5,
-  /// the value tuned on them (N is 130 for that). 0 keeps local_prior_weight throughout.
+  /// best match lies anywhere in the window, and counting it would make good odometry look bad.
+  /// Where odometry is good the prior holds what the scan says little of; where it slips the
+  /// weight stays near local_prior_weight. 0 keeps local_prior_weight throughout.
   double local_prior_points = 130.0;
   /// Track a scan only with the returns that the local map's scans could have seen (Visibility in
   /// correlative_matcher.h; `~local_visible_only`): the others, what came into view as the robot
-  /// drove on, pull the match back, and an office run's map came out 1% short.
+  /// drove on, pull the match back and shorten the map.
   bool local_visible_only = true;
   /// And only what they saw from the side each return faces (`~local_visible_side`; the normal
-  /// from its neighbours in the scan, surfaceNormals): through a door the robot sees the other
-  /// face of the wall beside it, a wall's thickness behind the face the local map holds, and a
-  /// scan 6.6 cm off matched it 3% better than the right pose (one node step 8-9 cm off, three times
-  /// at one door of a recorded large-floor run). On the 14 recorded large-floor runs (2 draws) the
-  /// maps' walls came out at 99.5% on average (98.4-98.7% without), the worst 95.6-95.8%
-  /// (86.1-88.9%); FR079 unchanged, but ACES's online pose 0.071-0.089 m (0.053-0.070 m) over 4
-  /// draws, so it is off by default and `explore.launch` (the simulated worlds) turns it on.
-  /// When fewer than half the returns pass, tracking takes all but those on the other face of a
-  /// wall the local map saw from its far side (Visibility::notBehindOf).
+  /// from its neighbours in the scan, surfaceNormals): through a door the robot sees the other face
+  /// of the wall beside it, a wall's thickness behind the face the local map holds, and matching it
+  /// shifts the scan. It costs accuracy on logs with noisier odometry, so it is off by default and
+  /// `explore.launch` (the simulated worlds) turns it on. When fewer than half the returns pass,
+  /// tracking takes all but those on the other face of a wall the local map saw from its far side
+  /// (Visibility::notBehindOf).
   bool local_visible_side = false;
   int submap_nodes = 10;            ///< nodes per loop-closure submap (`~submap_nodes`)
   /// [m] The search radius, the window of a closure's search: how far the estimate may have
   /// drifted, right after a closure (`~loop_search_radius`), growing by loop_search_growth per metre
   /// travelled since (`~loop_search_growth`) to loop_search_max_radius (`~loop_search_max_radius`).
-  /// A window wider than the drift finds the place next door: in the large floor's row of like rooms
-  /// a node was put 3 m off (2 m and 0.05 m per m, the old defaults: 2 of 17 recorded runs' maps
-  /// broke as soon as more submaps were tried; with 0.02 m per m a live run's map broke after 3 m
-  /// of window had grown). The simulator's and the Radish logs' corrections stay well within 1 m
-  /// and 0.01 m per m.
+  /// A window wider than the drift finds the place next door in a row of like rooms.
   double loop_search_radius = 1.0;
   double loop_search_growth = 0.01;       ///< [m per m travelled] (`~loop_search_growth`)
   double loop_search_max_radius = 6.0;    ///< [m] (`~loop_search_max_radius`)
   /// [m] Submaps with a node within the search radius plus this are tried (`~loop_search_reach`):
-  /// a scan shares much of what a submap's nodes saw from a few metres off them (the laser reaches
-  /// 6 m or more), and exploring a large floor the robot seldom passes within the radius of where
-  /// it was (one recorded run: 45 submaps tried in 338 nodes, 16 closures, the map bent by the
-  /// heading drift of the chain between them). The window stays the search radius.
+  /// a scan shares much of what a submap's nodes saw from a few metres off them, and exploring
+  /// a large floor the robot seldom passes within the radius of where it was. The window stays the
+  /// search radius.
   double loop_search_reach = 2.0;
   double loop_search_angle = 0.35;  ///< [rad] +- yaw of the loop search (`~loop_search_angle`)
   double loop_min_response = 0.55;  ///< mean likelihood a closure must reach (`~loop_min_response`)
@@ -177,24 +161,20 @@ struct GraphSlamParams {
   /// Also match each node against the newest submap whose nodes have all left its local map, if
   /// one of them lies within loop_search_reach (`~loop_recent_submap`). The older submaps alone are
   /// loops (the local map may still overlap the one in between); without this, nothing but the
-  /// chain of tracked edges holds a node to the last 30 nodes, and the chain's heading wanders by
-  /// a few hundredths of a degree per node. Searched in the tracking window
-  /// (local_search_max_window, local_search_angle), not the drift's: the chain since is short.
-  /// On 20 recorded large-floor runs, replayed twice: maps at or above 99% walls 36 of 40 with it,
-  /// 34 of 40 without (the worst 91.9 and 93.2% against 88.6 and 89.3%).
+  /// chain of tracked edges holds a node to the last 30 nodes, and the chain's heading wanders.
+  /// Searched in the tracking window (local_search_max_window, local_search_angle), not the drift's:
+  /// the chain since is short.
   bool loop_recent_submap = true;
   /// [m] A closure's standard deviations grow with d, the distance from the matched pose to the
   /// nearest node of the submap, as sqrt(1 + (d / this)^2) (`~loop_sigma_distance`): a scan taken
-  /// farther off sees less of what the submap saw, and the match leans towards it (an office run's
-  /// closures from 1-2 m off were 2.5 cm short on average, from within 0.5 m 0.04 cm; at equal
-  /// weight they shrank its map by 0.6%). 0: every closure weighs as a chain edge.
+  /// farther off sees less of what the submap saw, and the match leans towards it. 0: every
+  /// closure weighs as a chain edge.
   double loop_sigma_distance = 0.25;
   /// [m] A closure is measured again with only the returns its submap saw, from the side of the
   /// surface they face (`~loop_visible_shift`): the other face of a wall, seen from beyond it, pulls
-  /// the match towards the submap by up to the wall's thickness. Over a recorded large-floor run's
-  /// closures the radial error from 1-3 m off the submap went from -3 to -8 cm on average to -0.2
-  /// to -0.9 cm. The second measurement is kept when it lies within this distance (and 0.05 rad) of
-  /// the first and at least a quarter of the returns were seen. 0: measured once, with all returns.
+  /// the match towards the submap by up to the wall's thickness. The second measurement is kept
+  /// when it lies within this distance (and 0.05 rad) of the first and at least a quarter of the
+  /// returns were seen. 0: measured once, with all returns.
   double loop_visible_shift = 0.15;
   double loop_reject_chi2 = 50.0;   ///< closures above this error after optimizing are removed
   double edge_sigma_xy = 0.03;      ///< [m] standard deviation of an edge's translation

@@ -30,7 +30,7 @@ A team (launch/multi_explore.launch): with team_topic set (e.g. /explore/team), 
 where its robot is and where it goes (mbot_slam_navigation/ExplorerState, every cycle, under
 robot_name, default its namespace) and hears the others: a frontier whose goal lies within
 claim_radius (2.0 m) of a teammate's goal is left to it, and one nearer to a teammate than to this
-robot costs more (frontiers.share_out); of two robots heading for one place the one whose name sorts
+robot costs more (team.share_out); of two robots heading for one place the one whose name sorts
 first keeps it. A robot whose frontiers are all claimed waits; the team's exploration is complete
 for a robot when no frontier is left to anyone.
 """
@@ -62,9 +62,11 @@ from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
-from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, POTENTIAL_SCALE, ExploreState,
-                                                Frontier, GivenUp, GoalFields, Grid, MotionWatch, Plateau, Teammate,
-                                                rank_frontiers, share_out, tour_order, yields_goal)
+from mbot_slam_navigation.nav.explore_state import ExploreState, MotionWatch, Plateau
+from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, POTENTIAL_SCALE, Frontier, GivenUp,
+                                                Grid, rank_frontiers)
+from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
+from mbot_slam_navigation.nav.tour import GoalFields, tour_order
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
