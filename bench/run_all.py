@@ -105,13 +105,22 @@ def write_page() -> None:
                   '']
         peers = any('peer' in row for row in r['rows'])
         header = ['metric', 'value', 'unit', 'target'] + (['peer'] if peers else []) + ['note']
-        lines += ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
+        # rows of several parts (a world and a load, a log and a backend): one table per part
+        parts = []
         for row in r['rows']:
-            cells = [row.get('metric', ''), _value(row.get('value', '')), row.get('unit', ''), row.get('target', '')]
-            cells += [_value(row['peer']) if 'peer' in row else ''] if peers else []
-            cells += [row.get('note', '')]
-            lines.append('| ' + ' | '.join(str(c).replace('|', '\\|') for c in cells) + ' |')
-        lines.append('')
+            if not parts or parts[-1][0] != row.get('benchmark', ''):
+                parts.append((row.get('benchmark', ''), []))
+            parts[-1][1].append(row)
+        for part, rows in parts:
+            if len(parts) > 1:
+                lines += ['### %s' % part, '']
+            lines += ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
+            for row in rows:
+                cells = [row.get('metric', ''), _value(row.get('value', '')), row.get('unit', ''), row.get('target', '')]
+                cells += [_value(row['peer']) if 'peer' in row else ''] if peers else []
+                cells += [row.get('note', '')]
+                lines.append('| ' + ' | '.join(str(c).replace('|', '\\|') for c in cells) + ' |')
+            lines.append('')
     atomic_write(PAGE, '\n'.join(lines).rstrip() + '\n')
     print('wrote %s' % os.path.relpath(PAGE))
 

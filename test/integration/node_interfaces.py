@@ -49,9 +49,11 @@ def declared(page: str, node: str):
     return pub, sub, srv
 
 
-def mismatches(page: str, node: str):
-    """Texts naming each difference between the running node `node` and page `page`; [] if none."""
-    state = rosgraph.Master('/node_interfaces_check').getSystemState()
+def mismatches(page: str, node: str, state=None):
+    """Texts naming each difference between the running node `node` and page `page`; [] if none.
+    `state`: the master's getSystemState() (asked for when not given)."""
+    if state is None:
+        state = rosgraph.Master('/node_interfaces_check').getSystemState()
     actual = [sorted(name for name, nodes in kind if node in nodes) for kind in state]
     problems = []
     for (kind, have), want in zip(zip(('publishes', 'subscribes', 'serves'), actual), declared(page, node)):

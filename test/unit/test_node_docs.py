@@ -48,3 +48,18 @@ def test_a_launch_file_that_repeats_a_default_is_named(tmp_path):
     done = run('check_defaults.py', str(launch))
     assert done.returncode == 1
     assert 'passes ~planner_frequency = 0.33, its default' in done.stderr and 'hysteresis' not in done.stderr
+
+
+def test_the_live_check_names_a_topic_missing_from_the_page_and_one_the_node_lacks():
+    """node_interfaces.mismatches (run by the rostests against the real master) on a made-up
+    system state: map_server as its page declares it, then with one topic more and one less."""
+    sys.path.insert(0, os.path.join(ROOT, 'test', 'integration'))
+    from node_interfaces import mismatches
+    node = '/map_server'
+    pubs = [['/map', [node]], ['/map_metadata', [node]], ['/rosout', [node]]]
+    srvs = [['/static_map', [node]], ['/change_map', [node]], ['/map_server/get_loggers', [node]]]
+    assert mismatches('map_server', node, [pubs, [], srvs]) == []
+    extra = mismatches('map_server', node, [pubs + [['/map_extra', [node]]], [], srvs])
+    assert extra == ['/map_server publishes /map_extra, which docs/nodes/map_server.md does not list']
+    missing = mismatches('map_server', node, [pubs[1:], [], srvs])
+    assert missing == ['docs/nodes/map_server.md says /map_server publishes /map, but it does not']

@@ -106,7 +106,7 @@ def read_parameters(r: ParamReader) -> dict:
                                          "ours: relative standard deviation of the wheels' slip (0: exact odometry)",
                                          minimum=0.0)
     c['cmd_vel_timeout'] = r.number('cmd_vel_timeout', 0.5, '[s] ours: the robot stops when cmd_vel falls silent this '
-                                    'long', positive=True)
+                                    'long (0: never)', minimum=0.0)
     c['seed'] = r.integer('seed', 0, "ours: the random generator's seed (slip, laser noise)")
     return c
 
