@@ -4,6 +4,8 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "mbot_slam_navigation/core/costmap.h"
+
 namespace mbot {
 namespace core {
 namespace {
@@ -31,6 +33,23 @@ double remainingPath(const std::vector<Eigen::Vector2d>& plan, const Eigen::Vect
   double length = (plan[nearest] - position).norm();
   for (std::size_t i = nearest + 1; i < plan.size(); ++i) length += (plan[i] - plan[i - 1]).norm();
   return length;
+}
+
+bool planBlocked(const Costmap& costmap, const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector2d& position,
+                 double skip_m) {
+  if (plan.empty()) return false;
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < plan.size(); ++i) {
+    if ((plan[i] - position).squaredNorm() < (plan[nearest] - position).squaredNorm()) nearest = i;
+  }
+  for (std::size_t i = nearest; i < plan.size(); ++i) {
+    if ((plan[i] - position).norm() <= skip_m || (plan[i] - plan.back()).norm() <= skip_m) continue;
+    const Cell c = costmap.worldToCell(plan[i]);
+    if (!costmap.contains(c)) continue;
+    const uint8_t v = costmap.cost(c);
+    if (v >= cost::kInscribed && v != cost::kNoInformation) return true;
+  }
+  return false;
 }
 
 void MoveBaseStateMachine::reset(double now) {
@@ -89,7 +108,12 @@ GoalOutcome MoveBaseStateMachine::cycle(double now, const Eigen::Vector3d& goal,
 
   const bool replan_due =
       config_.planner_frequency > 0 && last_plan_time_ >= 0.0 && now - last_plan_time_ >= 1.0 / config_.planner_frequency;
-  if (state_ == MoveBaseState::kPlanning || (state_ == MoveBaseState::kControlling && replan_due)) {
+  // Without a map every obstacle is discovered on the way: a plan made through free-looking space
+  // runs into them. It is made again as soon as it crosses one, whatever planner_frequency says
+  // (with 0, ROS waits for the local planner to fail first, and the robot hesitates before each).
+  const bool blocked = state_ == MoveBaseState::kControlling && !replan_due && ports.planBlocked(plan_);
+  if (blocked) ports.info("blocked", "the plan crosses an obstacle seen since it was made; planning again", 5.0);
+  if (state_ == MoveBaseState::kPlanning || (state_ == MoveBaseState::kControlling && (replan_due || blocked))) {
     if (!planStep(now, *pose, goal, ports)) return GoalOutcome::kActive;
   }
 

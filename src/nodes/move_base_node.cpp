@@ -365,6 +365,13 @@ class MoveBase {
     bool makePlan(const Vec3& start, const Vec3& goal, Path2& path, std::string& why) override {
       return mb_.plan(*mb_.planner_, start, goal, path, why);
     }
+    bool planBlocked(const Path2& path) override {
+      const auto pose = mb_.global_->lookupRobotPose();
+      if (!pose) return false;
+      auto guard = mb_.global_->lock();
+      const auto& map = mb_.global_->master();
+      return core::planBlocked(map, path, pose->head<2>(), mb_.global_->config().circumscribed_radius + map.resolution());
+    }
     void planMade(const Path2& path, double goal_yaw) override {
       mb_.publishPath({&mb_.plan_pub_, &mb_.generic_plan_pub_}, path, mb_.global_->config().global_frame, goal_yaw);
     }

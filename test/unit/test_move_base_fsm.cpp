@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot_slam_navigation/core/costmap.h"
 #include "mbot_slam_navigation/core/move_base_fsm.h"
 
 namespace {
@@ -24,7 +25,7 @@ struct FakeWorld : mbot::core::MoveBasePorts {
   double now = 0.0;
   double dt = 0.1;                     // [s] the control period
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();
-  bool pose_ok = true, current = true, plan_ok = true, control_ok = true, reached = false;
+  bool pose_ok = true, current = true, plan_ok = true, control_ok = true, reached = false, blocked = false;
   double speed = 1.0;                  // how much of the command the robot achieves
   std::string plan_why = "no path";
   double recovery_s = 3.0;             // [s] each recovery takes
@@ -54,6 +55,7 @@ struct FakeWorld : mbot::core::MoveBasePorts {
     return true;
   }
   void planMade(const std::vector<Eigen::Vector2d>&, double) override {}
+  bool planBlocked(const std::vector<Eigen::Vector2d>&) override { return blocked; }
   void followPlan(const std::vector<Eigen::Vector2d>&, double) override { ++follows; }
   ControlResult computeVelocity() override {
     ControlResult c;
@@ -245,6 +247,44 @@ TEST(MoveBaseStateMachine, AFailedReplanWhileMovingStopsTheRobot) {
   EXPECT_GT(w.stops, stops);
   ASSERT_FALSE(w.warnings.empty());
   EXPECT_NE(w.warnings.front().find("stopping instead of following the old plan"), std::string::npos);
+}
+
+TEST(MoveBaseStateMachine, APlanThatRunsIntoANewObstacleIsMadeAgainAtOnce) {
+  MoveBaseConfig c = defaults();
+  ASSERT_EQ(c.planner_frequency, 0.0);  // ROS's default: plan only for a new goal or a failed control
+  MoveBaseStateMachine fsm(c);
+  FakeWorld w;
+  fsm.reset(0.0);
+  run(fsm, w, {50, 0, 0}, 2.0);
+  EXPECT_EQ(w.plans, 1);
+  w.blocked = true;  // an obstacle seen on the way, across the plan
+  fsm.cycle(w.now, {50, 0, 0}, w);
+  EXPECT_EQ(w.plans, 2);
+  EXPECT_EQ(w.follows, 2);  // the local planner follows the new plan in the same cycle
+  EXPECT_EQ(fsm.state(), MoveBaseState::kControlling);
+  EXPECT_GT(w.last_command.x(), 0.0);
+  w.blocked = false;
+  run(fsm, w, {50, 0, 0}, 2.0);
+  EXPECT_EQ(w.plans, 2);
+}
+
+TEST(MoveBaseStateMachine, APlanIsBlockedByAnInscribedCellButNotNearTheRobotTheGoalOrInUnknownSpace) {
+  mbot::core::Costmap map(200, 100, 0.05, Eigen::Vector2d(0, 0));  // 10 m x 5 m, free
+  std::vector<Eigen::Vector2d> plan;
+  for (double x = 1.0; x <= 9.0; x += 0.05) plan.emplace_back(x, 2.5);
+  const Eigen::Vector2d robot(1.0, 2.5);
+  EXPECT_FALSE(mbot::core::planBlocked(map, plan, robot, 0.3));
+  auto mark = [&](double x, uint8_t v) { map.setCost(map.worldToCell(Eigen::Vector2d(x, 2.5)), v); };
+  mark(5.0, mbot::core::cost::kNoInformation);
+  EXPECT_FALSE(mbot::core::planBlocked(map, plan, robot, 0.3)) << "unknown space does not block";
+  mark(1.2, mbot::core::cost::kInscribed);
+  mark(8.9, mbot::core::cost::kLethal);
+  EXPECT_FALSE(mbot::core::planBlocked(map, plan, robot, 0.3)) << "beside the robot and the goal: the planner allows it";
+  mark(6.0, mbot::core::cost::kInscribed);
+  EXPECT_TRUE(mbot::core::planBlocked(map, plan, robot, 0.3));
+  EXPECT_FALSE(mbot::core::planBlocked(map, plan, Eigen::Vector2d(7.0, 2.5), 0.3)) << "already passed";
+  mark(6.0, 252);
+  EXPECT_FALSE(mbot::core::planBlocked(map, plan, robot, 0.3)) << "a high cost is passable";
 }
 
 }  // namespace

@@ -33,6 +33,12 @@ class MoveBasePorts {
                         std::string& why) = 0;
   /// A new global plan was made (to publish).
   virtual void planMade(const std::vector<Eigen::Vector2d>& path, double goal_yaw) = 0;
+  /// Whether the plan now crosses an obstacle the global costmap did not hold when it was made
+  /// (checked every cycle while controlling; a blocked plan is made again at once).
+  virtual bool planBlocked(const std::vector<Eigen::Vector2d>& path) {
+    (void)path;
+    return false;
+  }
   /// The local planner is to follow this plan from now on.
   virtual void followPlan(const std::vector<Eigen::Vector2d>& path, double goal_yaw) = 0;
   /// The local planner's command for this cycle (invalid with why).
@@ -104,6 +110,15 @@ class MoveBaseStateMachine {
 /// [m] Along `plan` from its point nearest `position` to its end, plus the way to that point;
 /// infinity for an empty plan.
 double remainingPath(const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector2d& position);
+
+class Costmap;
+/// Whether `plan`, from its point nearest `position` on and leaving out the points within `skip_m`
+/// [m] of it and of the plan's end (the robot may stand in an inflated zone, the goal may lie in
+/// one: the planner allows both), crosses a cell of `costmap` at or above
+/// the inscribed cost (the robot cannot pass there). Unknown cells and points off the costmap do
+/// not block (the planners cross unknown space).
+bool planBlocked(const Costmap& costmap, const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector2d& position,
+                 double skip_m);
 
 }  // namespace core
 }  // namespace mbot
