@@ -9,7 +9,8 @@ WORLD.yaml is tools/generate_clutter.py's description beside WORLD.world. The tr
 move_base finishes the goal or after --limit simulated seconds (the goal is then cancelled).
 Printed: outcome (reached, aborted, timeout, error), simulated time from the goal to its end,
 distance driven (ground truth), collisions (the simulator's contacts), recovery behaviours run,
-move_base's last abort text, and the wall time.
+move_base's last abort text, the simulated seconds move_base commanded forward, turning on the
+spot, backing and standing still (where the time goes), and the wall time.
 """
 import argparse
 import json
@@ -67,6 +68,7 @@ def drive(info, limit):
     import rospy
     from actionlib_msgs.msg import GoalStatus
     from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+    from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
     from rosgraph_msgs.msg import Log
 
@@ -74,7 +76,17 @@ def drive(info, limit):
     from mbot_slam_navigation.nav.action_client import SimpleActionClient
 
     rospy.init_node('clutter_trial', disable_signals=True)
-    state = {'last': None, 'distance': 0.0, 'collisions': 0, 'recoveries': 0, 'recovery_names': []}
+    state = {'last': None, 'distance': 0.0, 'collisions': 0, 'recoveries': 0, 'recovery_names': [],
+             'cmd': None, 'cmd_time': None, 'shares': {'forward': 0.0, 'turning': 0.0, 'backing': 0.0, 'stopped': 0.0}}
+
+    def on_cmd(msg):
+        # what move_base commanded, by simulated time: where the time goes
+        now = rospy.Time.now().to_sec()
+        if state['cmd'] is not None and state['cmd_time'] is not None and now > state['cmd_time']:
+            vx, wz = state['cmd']
+            kind = 'forward' if vx > 0.02 else 'backing' if vx < -0.02 else 'turning' if abs(wz) > 0.02 else 'stopped'
+            state['shares'][kind] += min(now - state['cmd_time'], 1.0)
+        state['cmd'], state['cmd_time'] = (msg.linear.x, msg.angular.z), now
 
     def on_truth(msg):
         p = (msg.pose.pose.position.x, msg.pose.pose.position.y)
@@ -94,6 +106,7 @@ def drive(info, limit):
     rospy.Subscriber('/base_pose_ground_truth', Odometry, on_truth, queue_size=50)
     rospy.Subscriber('/gazebo/contacts', Contact, on_contact, queue_size=20)
     rospy.Subscriber('/rosout_agg', Log, on_log, queue_size=100)
+    rospy.Subscriber('/cmd_vel', Twist, on_cmd, queue_size=50)
     client = SimpleActionClient('move_base', MoveBaseAction, feedback=False)
     if not client.wait_for_server(rospy.Duration(120.0)):
         raise RuntimeError('move_base did not start within 120 s of wall time')
@@ -127,6 +140,7 @@ def drive(info, limit):
     return {'outcome': outcome, 'time_s': round(elapsed, 2), 'distance_m': round(state['distance'] - start_distance, 2),
             'collisions': state['collisions'], 'recoveries': state['recoveries'],
             'recovery_names': state['recovery_names'], 'why': why,
+            'command_s': {k: round(v, 1) for k, v in state['shares'].items()},
             'left_m': round(math.hypot(end[0] - info['goal']['x'], end[1] - info['goal']['y']), 2) if end else None}
 
 
