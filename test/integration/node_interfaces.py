@@ -46,6 +46,8 @@ def declared(page: str, node: str):
     sub += [(_pattern(t, node), False) for t in ('/tf', '/tf_static', '/clock')]
     pub.append((_pattern('/rosout', node), False))
     srv += [(_pattern('~' + s, node), False) for s in ('get_loggers', 'set_logger_level')]
+    if api.get('tf_required'):
+        srv.append((_pattern('~tf2_frames', node), False))  # tf2_ros's Python Buffer offers it
     return pub, sub, srv
 
 
