@@ -111,7 +111,7 @@ GoalOutcome MoveBaseStateMachine::cycle(double now, const Eigen::Vector3d& goal,
   // Without a map every obstacle is discovered on the way: a plan made through free-looking space
   // runs into them. It is made again as soon as it crosses one, whatever planner_frequency says
   // (with 0, ROS waits for the local planner to fail first, and the robot hesitates before each).
-  const bool blocked = state_ == MoveBaseState::kControlling && !replan_due && ports.planBlocked(plan_);
+  const bool blocked = state_ == MoveBaseState::kControlling && !replan_due && ports.planBlocked(plan_, *pose);
   if (blocked) ports.info("blocked", "the plan crosses an obstacle seen since it was made; planning again", 5.0);
   if (state_ == MoveBaseState::kPlanning || (state_ == MoveBaseState::kControlling && (replan_due || blocked))) {
     if (!planStep(now, *pose, goal, ports)) return GoalOutcome::kActive;
@@ -127,11 +127,9 @@ GoalOutcome MoveBaseStateMachine::cycle(double now, const Eigen::Vector3d& goal,
   }
 
   if (state_ == MoveBaseState::kControlling) {
-    bool done = false;
-    const GoalOutcome outcome = controlStep(now, goal, ports, &done);
-    if (done) return outcome;
+    if (const auto outcome = controlStep(now, *pose, goal, ports)) return *outcome;
   }
-  if (state_ == MoveBaseState::kClearing) return clearStep(now, ports);
+  if (state_ == MoveBaseState::kClearing) return clearStep(ports);
   return GoalOutcome::kActive;
 }
 
@@ -168,13 +166,14 @@ bool MoveBaseStateMachine::planStep(double now, const Eigen::Vector3d& pose, con
   return false;
 }
 
-// Sets *done when the cycle ends here (the goal reached, or no command and a replan is due).
-GoalOutcome MoveBaseStateMachine::controlStep(double now, const Eigen::Vector3d& goal, MoveBasePorts& ports, bool* done) {
+// The cycle ends here when the goal is reached, or when there is no command and a replan is due.
+std::optional<GoalOutcome> MoveBaseStateMachine::controlStep(double now, const Eigen::Vector3d& pose,
+                                                             const Eigen::Vector3d& goal, MoveBasePorts& ports) {
   if (new_plan_) {
     ports.followPlan(plan_, goal.z());
     new_plan_ = false;
   }
-  const ControlResult control = ports.computeVelocity();
+  const ControlResult control = ports.computeVelocity(pose);
   if (control.valid && control.footprint_scale < 1.0) {
     // Beside a wall the footprint can touch an inflated obstacle cell; moving out is routine.
     ports.info("footprint",
@@ -192,7 +191,6 @@ GoalOutcome MoveBaseStateMachine::controlStep(double now, const Eigen::Vector3d&
   }
   if (ports.goalReached()) {
     ports.stop();
-    *done = true;
     return GoalOutcome::kSucceeded;
   }
   ports.controlled();
@@ -224,14 +222,13 @@ GoalOutcome MoveBaseStateMachine::controlStep(double now, const Eigen::Vector3d&
       last_valid_plan_ = now;
       planning_retries_ = 0;
       state_ = MoveBaseState::kPlanning;
-      *done = true;
+      return GoalOutcome::kActive;
     }
   }
-  return GoalOutcome::kActive;
+  return std::nullopt;
 }
 
-GoalOutcome MoveBaseStateMachine::clearStep(double now, MoveBasePorts& ports) {
-  (void)now;
+GoalOutcome MoveBaseStateMachine::clearStep(MoveBasePorts& ports) {
   const auto& recoveries = config_.recoveries;
   if (trigger_ == RecoveryTrigger::kPlanning && (startsWith(why_, "goal occupied") || startsWith(why_, "goal off the costmap"))) {
     // Turning or backing up cannot free a goal cell or bring it onto the map; only clearing the

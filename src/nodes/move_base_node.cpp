@@ -365,19 +365,18 @@ class MoveBase {
     bool makePlan(const Vec3& start, const Vec3& goal, Path2& path, std::string& why) override {
       return mb_.plan(*mb_.planner_, start, goal, path, why);
     }
-    bool planBlocked(const Path2& path) override {
-      const auto pose = mb_.global_->lookupRobotPose();
-      if (!pose) return false;
+    bool planBlocked(const Path2& path, const Vec3& pose) override {
       auto guard = mb_.global_->lock();
       const auto& map = mb_.global_->master();
-      return core::planBlocked(map, path, pose->head<2>(), mb_.global_->config().circumscribed_radius + map.resolution());
+      return core::planBlocked(map, path, pose.head<2>(), mb_.global_->config().circumscribed_radius + map.resolution());
     }
     void planMade(const Path2& path, double goal_yaw) override {
       mb_.publishPath({&mb_.plan_pub_, &mb_.generic_plan_pub_}, path, mb_.global_->config().global_frame, goal_yaw);
     }
     void followPlan(const Path2& path, double goal_yaw) override { mb_.controller_->setPlan(mb_.toLocal(path), goal_yaw); }
-    core::ControlResult computeVelocity() override {
-      const auto local_pose = mb_.framesDiffer() ? mb_.local_->lookupRobotPose() : mb_.global_->lookupRobotPose();
+    core::ControlResult computeVelocity(const Vec3& pose) override {
+      // the cycle's pose, unless the local costmap lies in another frame
+      const auto local_pose = mb_.framesDiffer() ? mb_.local_->lookupRobotPose() : std::optional<Vec3>(pose);
       core::ControlResult control;
       if (!local_pose) {
         control.why = "tf: " + mb_.local_->tfProblem();

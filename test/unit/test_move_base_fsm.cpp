@@ -55,9 +55,9 @@ struct FakeWorld : mbot::core::MoveBasePorts {
     return true;
   }
   void planMade(const std::vector<Eigen::Vector2d>&, double) override {}
-  bool planBlocked(const std::vector<Eigen::Vector2d>&) override { return blocked; }
+  bool planBlocked(const std::vector<Eigen::Vector2d>&, const Eigen::Vector3d&) override { return blocked; }
   void followPlan(const std::vector<Eigen::Vector2d>&, double) override { ++follows; }
-  ControlResult computeVelocity() override {
+  ControlResult computeVelocity(const Eigen::Vector3d&) override {
     ControlResult c;
     c.valid = control_ok;
     if (c.valid) c.command = Eigen::Vector3d(0.3, 0.0, 0.0);

@@ -33,16 +33,17 @@ class MoveBasePorts {
                         std::string& why) = 0;
   /// A new global plan was made (to publish).
   virtual void planMade(const std::vector<Eigen::Vector2d>& path, double goal_yaw) = 0;
-  /// Whether the plan now crosses an obstacle the global costmap did not hold when it was made
-  /// (checked every cycle while controlling; a blocked plan is made again at once).
-  virtual bool planBlocked(const std::vector<Eigen::Vector2d>& path) {
-    (void)path;
+  /// Whether the plan, from the robot's `pose` (this cycle's) on, now crosses an obstacle the
+  /// global costmap did not hold when it was made (checked every cycle while controlling; a
+  /// blocked plan is made again at once).
+  virtual bool planBlocked(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector3d& pose) {
+    (void)path, (void)pose;
     return false;
   }
   /// The local planner is to follow this plan from now on.
   virtual void followPlan(const std::vector<Eigen::Vector2d>& path, double goal_yaw) = 0;
-  /// The local planner's command for this cycle (invalid with why).
-  virtual ControlResult computeVelocity() = 0;
+  /// The local planner's command for this cycle, the robot at `pose` (invalid with why).
+  virtual ControlResult computeVelocity(const Eigen::Vector3d& pose) = 0;
   /// Whether the local planner considers the goal reached.
   virtual bool goalReached() = 0;
   virtual void sendVelocity(const Eigen::Vector3d& command) = 0;
@@ -89,8 +90,10 @@ class MoveBaseStateMachine {
  private:
   GoalOutcome abort(const std::string& text, MoveBasePorts& ports);
   bool planStep(double now, const Eigen::Vector3d& pose, const Eigen::Vector3d& goal, MoveBasePorts& ports);
-  GoalOutcome controlStep(double now, const Eigen::Vector3d& goal, MoveBasePorts& ports, bool* done);
-  GoalOutcome clearStep(double now, MoveBasePorts& ports);
+  /// The goal's outcome when the cycle ends in the control step; nullopt to go on.
+  std::optional<GoalOutcome> controlStep(double now, const Eigen::Vector3d& pose, const Eigen::Vector3d& goal,
+                                         MoveBasePorts& ports);
+  GoalOutcome clearStep(MoveBasePorts& ports);
 
   MoveBaseConfig config_;
   MoveBaseState state_ = MoveBaseState::kPlanning;
