@@ -69,12 +69,12 @@ bool DiffDrive::step(double dt, double now_s, const World2D& world, int self_ind
   auto poseAt = [&](double f) { return integrateArc(pose_, 0.5 * f * (dl + dr), f * (dr - dl) / params_.wheel_separation_m); };
   bool blocked = false;
   Eigen::Vector3d next = poseAt(1.0);
-  if ((dl != 0.0 || dr != 0.0) && world.overlaps(footprintAt(next), self_index)) {
+  if ((dl != 0.0 || dr != 0.0) && world.overlaps(footprintAt(next), self_index, params_.body)) {
     blocked = true;
     double free = 0.0, hit = 1.0;
     for (int i = 0; i < 6; ++i) {
       const double mid = 0.5 * (free + hit);
-      (world.overlaps(footprintAt(poseAt(mid)), self_index) ? hit : free) = mid;
+      (world.overlaps(footprintAt(poseAt(mid)), self_index, params_.body) ? hit : free) = mid;
     }
     next = poseAt(free);
     dl *= free;

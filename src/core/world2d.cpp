@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace mbot {
 namespace core {
@@ -90,6 +92,76 @@ bool polygonTouchesCircle(const Polygon& polygon, const Eigen::Vector2d& c, doub
   return false;
 }
 
+// Ray p + t d (|d| = 1, world frame) against a raster: t >= 0 where the ray enters the first solid
+// cell (0 if it starts in one), or +inf within [0, t_max]. Walks the cells (Amanatides & Woo) in
+// the raster's own frame.
+double rayGrid(const Eigen::Vector2d& p_world, const Eigen::Vector2d& d_world, const GridShape& g, double t_max) {
+  const double c = std::cos(g.yaw), s = std::sin(g.yaw);
+  const Eigen::Vector2d q = p_world - g.origin;
+  const Eigen::Vector2d p((c * q.x() + s * q.y()) / g.resolution, (-s * q.x() + c * q.y()) / g.resolution);  // in cells
+  const Eigen::Vector2d d(c * d_world.x() + s * d_world.y(), -s * d_world.x() + c * d_world.y());
+  const double size[2] = {static_cast<double>(g.width), static_cast<double>(g.height)};
+  double t0 = 0.0, t1 = t_max / g.resolution;  // in cells along the ray
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(d[k]) < 1e-15) {
+      if (p[k] < 0.0 || p[k] > size[k]) return kInf;
+    } else {
+      double ta = (0.0 - p[k]) / d[k], tb = (size[k] - p[k]) / d[k];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+  }
+  if (t0 > t1) return kInf;
+  const Eigen::Vector2d start = p + t0 * d;
+  int x = std::clamp(static_cast<int>(std::floor(start.x())), 0, g.width - 1);
+  int y = std::clamp(static_cast<int>(std::floor(start.y())), 0, g.height - 1);
+  const int step_x = d.x() > 0 ? 1 : -1, step_y = d.y() > 0 ? 1 : -1;
+  const double dt_x = std::abs(d.x()) > 1e-15 ? 1.0 / std::abs(d.x()) : kInf;
+  const double dt_y = std::abs(d.y()) > 1e-15 ? 1.0 / std::abs(d.y()) : kInf;
+  double next_x = std::abs(d.x()) > 1e-15 ? (x + (step_x > 0 ? 1 : 0) - p.x()) / d.x() : kInf;
+  double next_y = std::abs(d.y()) > 1e-15 ? (y + (step_y > 0 ? 1 : 0) - p.y()) / d.y() : kInf;
+  double entered = t0;
+  while (true) {
+    if (g.solid(x, y)) return entered * g.resolution;
+    entered = std::min(next_x, next_y);
+    if (entered > t1) return kInf;
+    if (next_x < next_y) {
+      x += step_x;
+      next_x += dt_x;
+      if (x < 0 || x >= g.width) return kInf;
+    } else {
+      y += step_y;
+      next_y += dt_y;
+      if (y < 0 || y >= g.height) return kInf;
+    }
+  }
+}
+
+// True if the polygon (world frame) touches a solid cell of the raster.
+bool polygonTouchesGrid(const Polygon& polygon_world, const GridShape& g) {
+  const double c = std::cos(g.yaw), s = std::sin(g.yaw);
+  Polygon local;
+  local.reserve(polygon_world.size());
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(kInf), hi = Eigen::Vector2d::Constant(-kInf);
+  for (const auto& v : polygon_world) {
+    const Eigen::Vector2d q = v - g.origin;
+    local.emplace_back((c * q.x() + s * q.y()) / g.resolution, (-s * q.x() + c * q.y()) / g.resolution);
+    lo = lo.cwiseMin(local.back());
+    hi = hi.cwiseMax(local.back());
+  }
+  const int x0 = std::max(0, static_cast<int>(std::floor(lo.x()))), x1 = std::min(g.width - 1, static_cast<int>(std::floor(hi.x())));
+  const int y0 = std::max(0, static_cast<int>(std::floor(lo.y()))), y1 = std::min(g.height - 1, static_cast<int>(std::floor(hi.y())));
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      if (!g.solid(x, y)) continue;
+      const Polygon cell = {{x, y}, {x + 1, y}, {x + 1, y + 1}, {x, y + 1}};
+      if (polygonsOverlap(local, cell)) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 double pointPolygonDistance(const Eigen::Vector2d& point, const Polygon& polygon) {
@@ -112,18 +184,28 @@ World2D::World2D(double bucket_size_m) : bucket_(bucket_size_m) {
   if (!(bucket_size_m > 0.0)) throw std::invalid_argument("World2D: bucket size must be positive");
 }
 
-void World2D::addSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  segments_.push_back({a, b});
+void World2D::addSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, HeightRange heights) {
+  segments_.push_back({a, b, heights});
   dirty_ = true;
 }
 
-void World2D::addPolygon(const Polygon& polygon) {
+void World2D::addPolygon(const Polygon& polygon, HeightRange heights) {
   if (polygon.size() < 3) throw std::invalid_argument("World2D: a polygon needs at least 3 vertices");
-  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) addSegment(polygon[j], polygon[i]);
-  solids_.push_back(polygon);
+  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) addSegment(polygon[j], polygon[i], heights);
+  solids_.push_back({polygon, heights});
 }
 
-void World2D::addBox(const Eigen::Vector2d& center, double yaw_rad, double size_x_m, double size_y_m) {
+void World2D::addGrid(GridShape grid) {
+  if (grid.width <= 0 || grid.height <= 0 || grid.cells.size() != static_cast<std::size_t>(grid.width) * grid.height) {
+    throw std::invalid_argument("World2D: a grid of " + std::to_string(grid.width) + " x " + std::to_string(grid.height) +
+                                " cells needs as many values, got " + std::to_string(grid.cells.size()));
+  }
+  if (!(grid.resolution > 0.0)) throw std::invalid_argument("World2D: a grid's resolution must be positive");
+  grids_.push_back(std::move(grid));
+}
+
+void World2D::addBox(const Eigen::Vector2d& center, double yaw_rad, double size_x_m, double size_y_m,
+                     HeightRange heights) {
   if (!(size_x_m > 0.0 && size_y_m > 0.0)) throw std::invalid_argument("World2D: box sizes must be positive");
   const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
   Polygon box;
@@ -131,12 +213,12 @@ void World2D::addBox(const Eigen::Vector2d& center, double yaw_rad, double size_
     const Eigen::Vector2d local(0.5 * size_x_m * k.x(), 0.5 * size_y_m * k.y());
     box.push_back(center + Eigen::Vector2d(c * local.x() - s * local.y(), s * local.x() + c * local.y()));
   }
-  addPolygon(box);
+  addPolygon(box, heights);
 }
 
-void World2D::addCylinder(const Eigen::Vector2d& center, double radius_m) {
+void World2D::addCylinder(const Eigen::Vector2d& center, double radius_m, HeightRange heights) {
   if (!(radius_m > 0.0)) throw std::invalid_argument("World2D: cylinder radius must be positive");
-  circles_.push_back({center, radius_m});
+  circles_.push_back({center, radius_m, heights});
   dirty_ = true;
 }
 
@@ -193,10 +275,14 @@ void World2D::rebuildIfNeeded() const {
   }
 }
 
-double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double max_range_m, int skip_dynamic) const {
+double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double max_range_m, int skip_dynamic,
+                        double plane_z) const {
   rebuildIfNeeded();
   const Eigen::Vector2d d(std::cos(angle_rad), std::sin(angle_rad));
   double best = kInf;
+  for (const GridShape& g : grids_) {
+    if (g.heights.cuts(plane_z)) best = std::min(best, rayGrid(origin, d, g, std::min(best, max_range_m)));
+  }
   for (std::size_t i = 0; i < dynamic_.size(); ++i) {
     if (static_cast<int>(i) != skip_dynamic) best = std::min(best, rayPolygon(origin, d, dynamic_[i]));
   }
@@ -231,9 +317,13 @@ double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double 
         const int k = y * nx_ + x;
         for (int j = offsets_[k]; j < offsets_[k + 1]; ++j) {
           const int item = items_[j];
-          const double t = item >= 0 ? raySegment(origin, d, segments_[item].a, segments_[item].b)
-                                     : rayCircle(origin, d, circles_[-1 - item].c, circles_[-1 - item].r);
-          best = std::min(best, t);
+          if (item >= 0) {
+            const Segment& s = segments_[item];
+            if (s.h.cuts(plane_z)) best = std::min(best, raySegment(origin, d, s.a, s.b));
+          } else {
+            const Circle& c = circles_[-1 - item];
+            if (c.h.cuts(plane_z)) best = std::min(best, rayCircle(origin, d, c.c, c.r));
+          }
         }
         const double exit = std::min(next_x, next_y);
         if (best <= exit || exit > t1) break;
@@ -254,11 +344,11 @@ double World2D::castRay(const Eigen::Vector2d& origin, double angle_rad, double 
 
 void World2D::castScan(const Eigen::Vector3d& sensor_pose, double angle_min_rad, double angle_increment_rad, int beams,
                        double range_min_m, double range_max_m, double noise_stddev_m, double range_resolution_m,
-                       std::mt19937& rng, float* out, int skip_dynamic) const {
+                       std::mt19937& rng, float* out, int skip_dynamic, double plane_z) const {
   std::normal_distribution<double> noise(0.0, noise_stddev_m > 0.0 ? noise_stddev_m : 1.0);
   const Eigen::Vector2d origin = sensor_pose.head<2>();
   for (int i = 0; i < beams; ++i) {
-    double r = castRay(origin, sensor_pose.z() + angle_min_rad + i * angle_increment_rad, range_max_m, skip_dynamic);
+    double r = castRay(origin, sensor_pose.z() + angle_min_rad + i * angle_increment_rad, range_max_m, skip_dynamic, plane_z);
     if (std::isfinite(r)) {
       if (noise_stddev_m > 0.0) r += noise(rng);
       if (range_resolution_m > 0.0) r = std::round(r / range_resolution_m) * range_resolution_m;
@@ -269,7 +359,7 @@ void World2D::castScan(const Eigen::Vector3d& sensor_pose, double angle_min_rad,
   }
 }
 
-bool World2D::overlaps(const Polygon& polygon, int skip_dynamic) const {
+bool World2D::overlaps(const Polygon& polygon, int skip_dynamic, HeightRange body) const {
   rebuildIfNeeded();
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(kInf), hi = Eigen::Vector2d::Constant(-kInf);
   for (const auto& v : polygon) {
@@ -292,21 +382,25 @@ bool World2D::overlaps(const Polygon& polygon, int skip_dynamic) const {
           const int item = items_[j];
           if (item >= 0) {
             const Segment& s = segments_[item];
+            if (!s.h.overlaps(body)) continue;
             if (pointInPolygon(s.a, polygon)) return true;
             for (std::size_t a = 0, b = polygon.size() - 1; a < polygon.size(); b = a++) {
               if (segmentsIntersect(polygon[b], polygon[a], s.a, s.b)) return true;
             }
           } else {
             const Circle& c = circles_[-1 - item];
-            if (polygonTouchesCircle(polygon, c.c, c.r)) return true;
+            if (c.h.overlaps(body) && polygonTouchesCircle(polygon, c.c, c.r)) return true;
           }
         }
       }
     }
   }
   // Entirely inside a solid (no edge crossing): one vertex inside suffices.
-  for (const Polygon& s : solids_) {
-    if (pointInPolygon(polygon[0], s)) return true;
+  for (const Solid& s : solids_) {
+    if (s.h.overlaps(body) && pointInPolygon(polygon[0], s.polygon)) return true;
+  }
+  for (const GridShape& g : grids_) {
+    if (g.heights.overlaps(body) && polygonTouchesGrid(polygon, g)) return true;
   }
   return false;
 }

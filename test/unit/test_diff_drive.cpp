@@ -79,5 +79,7 @@ TEST(DiffDrive, SlipNoiseMakesOdometryDriftButNotTruth) {
   const double err = (a.odomPose().head<2>() - a.pose().head<2>()).norm();
   EXPECT_GT(err, 1e-4);
   EXPECT_LT(err, 0.5);
-  EXPECT_THROW(DiffDrive(DiffDriveParams{0.0}, kFootprint, {0, 0, 0}, 1), std::invalid_argument);
+  DiffDriveParams no_separation;
+  no_separation.wheel_separation_m = 0.0;
+  EXPECT_THROW(DiffDrive(no_separation, kFootprint, {0, 0, 0}, 1), std::invalid_argument);
 }

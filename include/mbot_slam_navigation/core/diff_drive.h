@@ -24,6 +24,7 @@ struct DiffDriveParams {
   double cmd_timeout_s = 0.5;            ///< no command for this long stops the robot; <= 0 disables
   double slip_stddev = 0.0;              ///< relative std-dev of each wheel's travel in odometry
   bool odometry_from_world = false;      ///< odometrySource "world": odometry is exact
+  HeightRange body;                      ///< [m above the floor] what the body spans; shapes outside it do not stop it
   /// Throws std::invalid_argument naming the field if a value is unusable.
   void validate() const;
 };
