@@ -1,7 +1,9 @@
 """The exploration report, ROS-free: the map (map_server format), the map with the robot's path and
 the frontier goals visited (map.png), explored area against time (area.png) and the figures
 (report.json); with the world's ground truth also coverage of the reachable free space and wall
-accuracy. Map frame = world frame (SLAM started at the spawn pose (0, 0, 0)); metres, seconds.
+accuracy. The map is scored in the world frame: `world_from_map` (the map frame's pose in the world,
+from the spawn pose) moves it there; the identity when SLAM started at the world origin. Metres,
+seconds.
 """
 import json
 import math
@@ -17,6 +19,31 @@ from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupan
 from mbot_slam_navigation.nav.frontiers import Grid
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
 from mbot_slam_navigation.sim.sdf_world import World
+from mbot_slam_navigation.transforms import compose2d
+
+Pose2D = Tuple[float, float, float]
+
+
+def map_in_world(m: Grid, world_from_map: Pose2D) -> Grid:
+    """The map moved into the world frame by the pose of its frame there: its origin shifted, or for a
+    turned frame resampled (nearest cell) into a grid aligned with the world's axes, unknown around."""
+    x, y, yaw = world_from_map
+    if abs(math.sin(yaw)) < 1e-9 and math.cos(yaw) > 0:
+        return Grid(m.data, m.resolution, (m.origin[0] + x, m.origin[1] + y))
+    rows, cols = m.data.shape
+    corners = np.array([compose2d(world_from_map, (m.origin[0] + a * cols * m.resolution,
+                                                   m.origin[1] + b * rows * m.resolution, 0.0))[:2]
+                        for a in (0, 1) for b in (0, 1)])
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    out_shape = (int(math.ceil((hi[1] - lo[1]) / m.resolution)), int(math.ceil((hi[0] - lo[0]) / m.resolution)))
+    # world cell centre -> map frame -> map cell (nearest), as an affine map for OpenCV
+    c, s = math.cos(yaw), math.sin(yaw)
+    ox, oy = lo[0] + 0.5 * m.resolution - x, lo[1] + 0.5 * m.resolution - y
+    a = np.array([[c, s, (c * ox + s * oy - m.origin[0]) / m.resolution - 0.5],
+                  [-s, c, (-s * ox + c * oy - m.origin[1]) / m.resolution - 0.5]])
+    data = cv2.warpAffine(m.data.astype(np.int16), a, (out_shape[1], out_shape[0]),
+                          flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP, borderValue=-1)
+    return Grid(data.astype(m.data.dtype), m.resolution, (float(lo[0]), float(lo[1])))
 
 
 def known_area(m: Grid) -> float:
@@ -160,27 +187,33 @@ def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 40
 
 
 def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World], start: Tuple[float, float],
-                 robot_radius: float, rooms) -> Dict:
+                 robot_radius: float, rooms, world_from_map: Pose2D = (0.0, 0.0, 0.0)) -> Dict:
     """`figures` with the map's own (explored area; against the world when given: coverage, walls,
-    each room's share), after writing the map (map.pgm, map.yaml) into report_dir."""
+    each room's share), after writing the map (map.pgm, map.yaml) into report_dir. `start` is in the
+    map frame."""
     os.makedirs(report_dir, exist_ok=True)
     figures['explored_area_m2'] = round(known_area(m), 2)
     if world is not None:
-        truth = rasterize(world, m.resolution)  # once: it is the slow part of the report
-        figures.update(ground_truth_figures(m, world, start, robot_radius, truth=truth))
+        seen = map_in_world(m, world_from_map)
+        start_world = compose2d(world_from_map, (start[0], start[1], 0.0))[:2]
+        truth = rasterize(world, m.resolution)  # once for all the figures below
+        figures.update(ground_truth_figures(seen, world, start_world, robot_radius, truth=truth))
         if rooms:
             figures['room_coverage'] = {k: round(v, 3) for k, v in
-                                        room_coverage(m, truth[0], truth[1], m.resolution, rooms=rooms).items()}
+                                        room_coverage(seen, truth[0], truth[1], m.resolution, rooms=rooms).items()}
     save_map(os.path.join(report_dir, 'map'), m.data, m.resolution, (m.origin[0], m.origin[1], 0.0))
     return figures
 
 
 def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
                  curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
-                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
+                 start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=(),
+                 world_from_map: Pose2D = (0.0, 0.0, 0.0)) -> Dict:
     """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
-    With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free."""
-    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms)
+    With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free.
+    `world` holds the shapes that count (World.blocking for the robot's heights); the map, path and
+    start are in the map frame, whose pose in the world is `world_from_map`."""
+    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms, world_from_map)
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)

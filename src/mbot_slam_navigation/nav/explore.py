@@ -49,7 +49,7 @@ import tf2_ros
 from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import Point, Twist, Vector3
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-from nav_msgs.msg import OccupancyGrid
+from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, ColorRGBA
 from std_srvs.srv import Empty
@@ -70,8 +70,9 @@ from mbot_slam_navigation.nav.tour import GoalFields, tour_order
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.sdf_world import load_world
+from mbot_slam_navigation.sim.ground_truth import as_the_robot_meets_it
 from mbot_slam_navigation.topic_watch import WatchedSubscriber
-from mbot_slam_navigation.transforms import quaternion_to_yaw
+from mbot_slam_navigation.transforms import compose2d, inverse2d, quaternion_to_yaw
 
 
 BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot is stuck, not done
@@ -206,6 +207,7 @@ class Explore:
         self.return_to_start = c.return_to_start
         self.report_dir = c.report_dir
         self.world_name = c.world_name or rospy.get_param('/gazebo/world_name', '')
+        self.world_from_map = (0.0, 0.0, 0.0)  # the map frame in the world (map_in_world), for the report
         self.robot_radius = c.robot_radius
         self.progress_period = c.progress_period
         self.shutdown_when_done = c.shutdown_when_done
@@ -316,6 +318,33 @@ class Explore:
         q = t.transform.rotation
         return t.transform.translation.x, t.transform.translation.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
 
+    def map_in_world(self, start) -> Tuple[float, float, float]:
+        """The map frame's pose in the world, for the report's ground truth: from the simulator's
+        ground truth of the robot at the start (base_pose_ground_truth) and its pose in the map; the
+        identity without a world or without ground truth (a real robot)."""
+        if not self.world_name:
+            return 0.0, 0.0, 0.0
+        topic = rospy.resolve_name('base_pose_ground_truth')
+        try:
+            truth = rospy.wait_for_message(topic, Odometry, timeout=5.0)
+        except (rospy.ROSException, rospy.ROSInterruptException):
+            rospy.loginfo('explore: no ground truth on %s: the report takes the map frame as the world frame', topic)
+            return 0.0, 0.0, 0.0
+        p, q = truth.pose.pose.position, truth.pose.pose.orientation
+        return compose2d((p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)), inverse2d(start))
+
+    def truth_world(self):
+        """The world file's shapes that meet this robot's body (from its URDF, robot_description),
+        or None when there is no world file."""
+        if not (self.world_name and os.path.isfile(self.world_name)):
+            return None
+        world = load_world(self.world_name, rospy.get_param('/gazebo/map_unknown', 'solid'))
+        key = rospy.search_param('robot_description')
+        world, warning = as_the_robot_meets_it(world, rospy.get_param(key, '') if key else None, key or '')
+        if warning:
+            rospy.logwarn('explore: %s' % warning)
+        return world
+
     def goals_failed(self) -> int:
         return sum(not reached for _, _, reached in self.goals)
 
@@ -420,6 +449,7 @@ class Explore:
         wall0 = time.monotonic()
         self.cpu0 = time.process_time()  # the report's CPU while exploring: start-up and report apart
         rospy.loginfo('explore: started at (%.2f, %.2f)', start[0], start[1])
+        self.world_from_map = self.map_in_world(start)
         try:
             outcome = self.explore(wall0)
         except Exception as e:  # a bug of ours: stop the robot and report it rather than die silently
@@ -711,9 +741,8 @@ class Explore:
         if self.error:
             figures['error'] = self.error
         if self.report_dir and self.map is not None:
-            world, rooms = None, ()
-            if self.world_name and os.path.isfile(self.world_name):
-                world = load_world(self.world_name)
+            world, rooms = self.truth_world(), ()
+            if world is not None:
                 rooms_file = rooms_file_of(self.world_name)
                 if os.path.isfile(rooms_file):
                     try:
@@ -721,7 +750,8 @@ class Explore:
                     except ValueError as e:
                         rospy.logwarn('explore: no coverage per room: %s' % e)
             figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
-                                                  self.curve, figures, world, start[:2], self.robot_radius, rooms)
+                                                  self.curve, figures, world, start[:2], self.robot_radius, rooms,
+                                                  self.world_from_map)
             print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
                   % os.path.abspath(self.report_dir), flush=True)
         for k, v in figures.items():

@@ -1,6 +1,6 @@
 """gazebo_sim: the ROS face of the 2D simulator (stands in for gzserver + gazebo_ros plugins).
 
-Parameters (private): world_name (SDF file), real_time_factor (1.0; 0 = as fast as possible;
+Parameters (private): world_name (SDF file or map_server YAML), map_unknown (solid), real_time_factor (1.0; 0 = as fast as possible;
 'auto' = as fast as the nodes that report on /sim_heartbeat keep up, see sim/pacing.py),
 min_real_time_factor (0.25) and max_real_time_factor (100) for auto, max_lag (0.15 simulated s:
 the lag of the slowest node that auto aims below; defaults in sim/pacing.py), max_hold (0.1 wall s:
@@ -40,6 +40,7 @@ from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.nonblocking_publisher import nonblocking_publisher
 from mbot_slam_navigation.sim import pacing
 from mbot_slam_navigation.sim.pacing import PacingError, make_pacer
+from mbot_slam_navigation.sim.map_world import UNKNOWN_CHOICES
 from mbot_slam_navigation.sim.sdf_world import World, load_world, parse_actors
 from mbot_slam_navigation.sim.simulation import Simulation, SimulationError
 from mbot_slam_navigation.transforms import (matrix_to_quaternion, quaternion_multiply, quaternion_to_yaw,
@@ -101,7 +102,12 @@ def read_parameters(r: ParamReader) -> dict:
     c['paused'] = r.boolean('paused', False, 'start paused (/gazebo/unpause_physics starts it)')
     c['gui'] = r.boolean('gui', False, 'open the top-down viewer window')
     c['gazebo_namespace'] = r.string('gazebo_namespace', 'gazebo', "the services' and topics' namespace")
-    c['world_name'] = r.string('world_name', '', "the SDF world file ('': an empty world)")
+    c['world_name'] = r.string('world_name', '', "the world: an SDF world file, or a map_server YAML map ('': an empty "
+                               "world)")
+    c['map_unknown'] = r.string('map_unknown', 'solid', "ours: with a map YAML as the world, its unknown cells are "
+                                "'solid' (walls: a saved map's outside) or 'free'")
+    if c['map_unknown'] not in UNKNOWN_CHOICES:
+        raise ValueError("parameter %s must be 'solid' or 'free', got %r" % (r.where('map_unknown'), c['map_unknown']))
     c['odometry_slip_stddev'] = r.number('odometry_slip_stddev', 0.02,
                                          "ours: relative standard deviation of the wheels' slip (0: exact odometry)",
                                          minimum=0.0)
@@ -125,7 +131,7 @@ class SimNode:
         self.gz_ns = '/' + c['gazebo_namespace'].strip('/')
         world_path = c['world_name']
         if world_path:
-            world = load_world(world_path)  # raises XmlError naming file and line
+            world = load_world(world_path, c['map_unknown'])  # raises XmlError or MapFileError naming the file
         else:
             world = World(name='empty')
         for w in world.warnings:

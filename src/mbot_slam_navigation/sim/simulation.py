@@ -3,6 +3,10 @@
 All poses are (x [m], y [m], yaw [rad]) of base frames in the world frame; time is seconds of
 simulated time. The hot loops (ray casting, collision) run in the C++ core.
 
+Heights: a shape stops a robot if it overlaps the robot's body (from GROUND_CLEARANCE to the top
+of its URDF collision geometry) and a laser sees it if the laser's scan plane cuts it; a lintel over
+a door or a table top above the robot does neither.
+
 People (SDF actors) walk their scripts; lasers see them and robots collide with them. A person
 yields: while its next step would bring it within YIELD_MARGIN of a robot (and closer than it is),
 its script waits; after PERSON_PATIENCE s of waiting it walks on regardless, as Gazebo's actors
@@ -27,6 +31,8 @@ Pose2D = Tuple[float, float, float]
 YIELD_MARGIN = 0.1      # [m] a person keeps this gap to a robot while it can
 PERSON_PATIENCE = 10.0  # [s] of simulated time a person waits for a robot before walking on
 TOUCH = 0.02            # [m] a robot stopped this close to a person touched it
+GROUND_CLEARANCE = 0.01  # [m] shapes lower than this (floor tiles, mats) are driven over
+SPAWN_SEARCH = 5.0      # [m] how far from a spawn pose in a wall the nearest free place is looked for
 
 
 @dataclass
@@ -101,9 +107,12 @@ class Simulation:
         self.geometry = _core._World2D(0.5)
         for s in world.shapes:
             if s.kind == 'box':
-                self.geometry.add_box(np.array([s.x, s.y]), s.yaw, s.size_x, s.size_y)
+                self.geometry.add_box(np.array([s.x, s.y]), s.yaw, s.size_x, s.size_y, s.z_lo, s.z_hi)
+            elif s.kind == 'circle':
+                self.geometry.add_cylinder(np.array([s.x, s.y]), s.radius, s.z_lo, s.z_hi)
             else:
-                self.geometry.add_cylinder(np.array([s.x, s.y]), s.radius)
+                self.geometry.add_grid(s.cells.astype(np.uint8), np.array([s.x, s.y]), s.yaw, s.resolution,
+                                       s.z_lo, s.z_hi)
         for actor in world.actors:
             self.add_person(actor)
 
@@ -134,16 +143,34 @@ class Simulation:
         params.cmd_timeout = self.cmd_timeout
         params.slip_stddev = self.slip_stddev
         params.odometry_from_world = spec.drive.odometry_source == 'world'
+        params.set_body_heights(GROUND_CLEARANCE, spec.height)
         seed = self.seed * 7919 + len(self.robots) + 1
         drive = _core._DiffDrive(params, [np.asarray(v, float) for v in spec.footprint], np.asarray(pose, float), seed)
         robot = Robot(name=name, namespace=namespace, spec=spec, drive=drive, spawn_pose=tuple(pose),
                       lasers=[Laser(l, _core._Rng(seed * 31 + i), self.time) for i, l in enumerate(spec.lasers)],
                       next_odom_time=self.time)
         self._update_dynamic(extra=robot)
-        if self.geometry.overlaps(drive.footprint_in_world(), len(self.robots)):
-            raise SimulationError('model "%s" at (%.2f, %.2f) would overlap an obstacle' % (name, pose[0], pose[1]))
+        if self.geometry.overlaps(drive.footprint_in_world(), len(self.robots), GROUND_CLEARANCE, spec.height):
+            free = self.nearest_free(spec, pose, len(self.robots))
+            raise SimulationError('model "%s" at (%.2f, %.2f) would overlap an obstacle; %s'
+                                  % (name, pose[0], pose[1], 'the nearest free place is (%.2f, %.2f)' % free
+                                     if free else 'no free place within %.0f m' % SPAWN_SEARCH))
         self.robots[name] = robot
         return robot
+
+    def nearest_free(self, spec: RobotSpec, pose: Pose2D, skip: int = -1, step: float = 0.05) -> Optional[Tuple[float, float]]:
+        """(x, y) [m] nearest to `pose` (same yaw, on rings `step` apart) where the robot fits, or None
+        within SPAWN_SEARCH."""
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        foot = np.asarray(spec.footprint, float) @ np.array([[c, s], [-s, c]])
+        for k in range(1, int(SPAWN_SEARCH / step) + 1):
+            r = k * step
+            n = max(8, int(2 * math.pi * r / step))
+            for a in np.arange(n) * 2 * math.pi / n:
+                x, y = pose[0] + r * math.cos(a), pose[1] + r * math.sin(a)
+                if not self.geometry.overlaps(foot + (x, y), skip, GROUND_CLEARANCE, spec.height):
+                    return x, y
+        return None
 
     def delete(self, name: str) -> None:
         if name in self.people:
@@ -282,7 +309,7 @@ class Simulation:
         index = list(self.robots).index(robot.name)
         return _core._cast_scan(self.geometry, np.asarray(robot.laser_pose(laser), float), s.angle_min,
                                 s.angle_increment, s.samples, s.range_min, s.range_max, s.noise_stddev,
-                                s.range_resolution, laser.rng, index)
+                                s.range_resolution, laser.rng, index, s.height)
 
     def _update_people(self) -> None:
         self.geometry.set_dynamic_circles([np.array([p.pose[0], p.pose[1], p.actor.radius]) for p in self.people.values()])

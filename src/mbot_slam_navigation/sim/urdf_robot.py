@@ -62,6 +62,8 @@ class LaserSpec:
     topic: str = 'scan'
     frame_id: str = ''
     pose_in_base: tuple = (0.0, 0.0, 0.0)  # (x [m], y [m], yaw [rad]) in the drive's robot base frame
+    z_in_base: float = 0.0                 # [m] the scan plane's height in the robot base frame
+    height: float = float('nan')           # [m] the scan plane above the floor (parse_urdf sets it)
     samples: int = 360
     angle_min: float = -math.pi            # [rad]
     angle_max: float = math.pi
@@ -95,6 +97,7 @@ class RobotSpec:
     footprint: np.ndarray          # (N, 2) convex polygon [m] in the robot base frame
     warnings: List[str] = field(default_factory=list)
     wheels: List[WheelJoint] = field(default_factory=list)
+    height: float = float('inf')   # [m] top of the collision geometry above the floor (its lowest point)
 
 
 def _bool(text: str) -> bool:
@@ -134,9 +137,12 @@ def parse_urdf(text: str, source: str = 'robot_description') -> RobotSpec:
                        % (where(source, lines, root), drive.robot_base_frame, ', '.join(sorted(link_tf))))
     base_inv = np.linalg.inv(link_tf[drive.robot_base_frame])
     laser_specs = [_read_laser(ref, s, base_inv, link_tf, source, lines, warnings) for ref, s in lasers]
-    footprint = _footprint(links, link_tf, base_inv, source, lines, warnings)
+    footprint, (floor_z, top_z) = _footprint(links, link_tf, base_inv, source, lines, warnings)
+    for laser in laser_specs:
+        laser.height = laser.z_in_base - floor_z
     return RobotSpec(name=root.get('name', 'robot'), drive=drive, lasers=laser_specs, footprint=footprint,
-                     warnings=warnings, wheels=_wheel_joints(root, drive, source, lines, warnings))
+                     warnings=warnings, wheels=_wheel_joints(root, drive, source, lines, warnings),
+                     height=top_z - floor_z)
 
 
 def _wheel_joints(root, drive: DriveSpec, source, lines, warnings) -> List[WheelJoint]:
@@ -248,7 +254,9 @@ def _read_laser(reference, sensor, base_inv, link_tf, source, lines, warnings) -
     if pose_text:
         v = floats(pose_text, 6, here + ' <pose>')
         sensor_tf = from_xyz_rpy(v[:3], v[3:])
-    spec.pose_in_base = planar(base_inv @ link_tf[reference] @ sensor_tf)
+    in_base = base_inv @ link_tf[reference] @ sensor_tf
+    spec.pose_in_base = planar(in_base)
+    spec.z_in_base = float(in_base[2, 3])
 
     def number(path, default):
         text = child_text(sensor, path)
@@ -288,8 +296,9 @@ def _read_laser(reference, sensor, base_inv, link_tf, source, lines, warnings) -
     return spec
 
 
-def _footprint(links, link_tf, base_inv, source, lines, warnings) -> np.ndarray:
-    """Convex hull of every collision geometry, projected on the base frame's xy plane."""
+def _footprint(links, link_tf, base_inv, source, lines, warnings):
+    """(convex hull of every collision geometry projected on the base frame's xy plane, (lowest,
+    highest) z [m] of that geometry in the base frame: the floor the wheels stand on and the top)."""
     points = []
     circle = np.linspace(0, 2 * math.pi, 16, endpoint=False)
     for name, link in links.items():
@@ -315,8 +324,11 @@ def _footprint(links, link_tf, base_inv, source, lines, warnings) -> np.ndarray:
             else:
                 warnings.append('%s: <%s> collision is left out of the footprint' % (where(source, lines, g), g.tag))
                 continue
-            points.append((tf[:3, :3] @ local.T).T[:, :2] + tf[:2, 3])
+            if g.tag == 'sphere':
+                local = np.vstack([local, [[0, 0, -r], [0, 0, r]]])
+            points.append((tf[:3, :3] @ local.T).T + tf[:3, 3])
     if not points:
         raise XmlError('%s: no link has box, cylinder or sphere collision geometry: no footprint to collide with'
                        % source)
-    return convex_hull(np.vstack(points))
+    p = np.vstack(points)
+    return convex_hull(p[:, :2]), (float(p[:, 2].min()), float(p[:, 2].max()))

@@ -4,26 +4,30 @@ import math
 import cv2
 import numpy as np
 
-from mbot_slam_navigation.sim.simulation import Simulation
+from mbot_slam_navigation.sim.ground_truth import draw_solids
+from mbot_slam_navigation.sim.sdf_world import World
+from mbot_slam_navigation.sim.simulation import GROUND_CLEARANCE, Simulation
 
 
 class TopDownViewer:
-    def __init__(self, world, pixels_per_m: float = 50.0, window: str = 'gazebo_sim'):
+    """Shapes that a body up to BODY_HEIGHT meets are dark; higher ones (lintels, shelves) light grey:
+    robots pass under them and lasers at the usual heights do not see them."""
+
+    BODY_HEIGHT = 0.5  # [m]
+
+    def __init__(self, world: World, pixels_per_m: float = 50.0, window: str = 'gazebo_sim'):
         b = world.bounds() or (-5.0, -5.0, 5.0, 5.0)
         self.lo = np.array(b[:2]) - 0.5
         self.scale = pixels_per_m
         size = ((np.array(b[2:]) + 0.5 - self.lo) * pixels_per_m).astype(int)
         self.window = window
         self.background = np.full((size[1], size[0], 3), 255, np.uint8)
-        for s in world.shapes:
-            if s.kind == 'box':
-                c, si = math.cos(s.yaw), math.sin(s.yaw)
-                corners = [(s.x + c * a * s.size_x / 2 - si * b_ * s.size_y / 2,
-                            s.y + si * a * s.size_x / 2 + c * b_ * s.size_y / 2)
-                           for a, b_ in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-                cv2.fillPoly(self.background, [self.px(corners)], (60, 60, 60))
-            else:
-                cv2.circle(self.background, tuple(self.px([(s.x, s.y)])[0]), int(s.radius * self.scale), (60, 60, 60), -1)
+        low = world.blocking(GROUND_CLEARANCE, self.BODY_HEIGHT)
+        high = World(world.name, [s for s in world.shapes if not s.blocks(GROUND_CLEARANCE, self.BODY_HEIGHT)])
+        for part, colour in ((high, (200, 200, 200)), (low, (60, 60, 60))):
+            if part.shapes:
+                mask = draw_solids(part, tuple(self.lo), (size[1], size[0]), 1.0 / pixels_per_m)[::-1]
+                self.background[mask > 0] = colour
 
     def px(self, points):
         p = (np.asarray(points, float) - self.lo) * self.scale
