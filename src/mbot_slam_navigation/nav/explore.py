@@ -55,7 +55,7 @@ from std_msgs.msg import Bool, ColorRGBA
 from std_srvs.srv import Empty
 from visualization_msgs.msg import Marker, MarkerArray
 
-from mbot_slam_navigation import explore_report
+from mbot_slam_navigation import _core, explore_report
 from mbot_slam_navigation.batched_reads import clock_at_most_every
 from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
 from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
@@ -64,7 +64,7 @@ from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
 from mbot_slam_navigation.nav.explore_state import ExploreState, MotionWatch, Plateau
 from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, POTENTIAL_SCALE, Frontier, GivenUp,
-                                                Grid, rank_frontiers)
+                                                Grid, passable, rank_frontiers)
 from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
 from mbot_slam_navigation.nav.tour import GoalFields, tour_order
 from mbot_slam_navigation.nav.params import ParamReader
@@ -75,6 +75,8 @@ from mbot_slam_navigation.topic_watch import WatchedSubscriber
 from mbot_slam_navigation.transforms import compose2d, inverse2d, quaternion_to_yaw
 
 
+# [s per m of path] the way back to the start may take: 0.1 m/s, turns and replanning included
+RETURN_S_PER_M = 10.0
 BOXED_IN_M2 = 2.0  # [m^2] reachable on the global costmap below which the robot is stuck, not done
 # A frontier near a place visited before is gone back to (when nothing else is left) only if it is
 # this many times min_frontier_size: in the apartment the ones of 0.8-0.9 m were nooks that no
@@ -167,7 +169,8 @@ def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> Simple
     c.read_period = r.number('read_period', 0.02,
                              '[s] ours: /clock and /tf are read at most this often, in batches (0: every message)',
                              minimum=0.0)
-    c.return_timeout = r.number('return_timeout', 120.0, '[s] ours: time allowed to return to the start',
+    c.return_timeout = r.number('return_timeout', 120.0, '[s] ours: time allowed to return to the start (at least; '
+                                '10 s per metre of the way back when that is more)',
                                 positive=True)
     c.escape_distance = r.number('escape_distance', 0.6, '[m] ours: how far to back out along the path when stuck',
                                  positive=True)
@@ -344,6 +347,21 @@ class Explore:
         if warning:
             rospy.logwarn('explore: %s' % warning)
         return world
+
+    def return_allowance(self, start) -> float:
+        """[s] for the way back: return_timeout, or RETURN_S_PER_M per metre of the path to the start
+        on the global costmap if that is longer (a building's far wing is minutes away)."""
+        pose, costmap, m = self.robot_pose(), self.costmap, self.map
+        if pose is None or costmap is None or m is None:
+            return self.return_timeout
+        rr, rc = costmap.cell_of(pose[0], pose[1])
+        sr, sc = costmap.cell_of(start[0], start[1])
+        if not (costmap.inside(rr, rc) and costmap.inside(sr, sc)):
+            return self.return_timeout
+        lengths = _core._path_lengths(passable(costmap, m).astype(np.uint8), int(rc), int(rr))
+        path_m = lengths[sr, sc] * costmap.resolution if lengths[sr, sc] >= 0 else math.hypot(
+            pose[0] - start[0], pose[1] - start[1])
+        return max(self.return_timeout, RETURN_S_PER_M * path_m)
 
     def goals_failed(self) -> int:
         return sum(not reached for _, _, reached in self.goals)
@@ -715,10 +733,11 @@ class Explore:
             self.cmd_pub.publish(Twist())
             rospy.logerr('explore: the robot is stuck at %s; the exploration ends here' % (self.robot_pose(),))
         elif self.return_to_start:
-            rospy.loginfo('explore: returning to the start pose (%.2f, %.2f)', start[0], start[1])
+            allowed = self.return_allowance(start)
+            rospy.loginfo('explore: returning to the start pose (%.2f, %.2f), %.0f s allowed', start[0], start[1], allowed)
             self.send(*start)
-            if not self.wait_for_goal(self.return_timeout):
-                rospy.logwarn('explore: not back at the start after %.0f s; stopping there' % self.return_timeout)
+            if not self.wait_for_goal(allowed):
+                rospy.logwarn('explore: not back at the start after %.0f s; stopping there' % allowed)
                 self.move_base.cancel_goal()
             pose = self.robot_pose()
             if pose is not None:

@@ -22,6 +22,13 @@ class Blacklisted:
     size_m: float = 0.0
     why: str = ''                     # the last failure's reason
     reached: bool = False             # the robot got to the goal (not a failure)
+    _box: Tuple = field(default=(0, None, None), repr=False, compare=False)  # (len(cells), lo, hi) cached
+
+    def box(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) corners [m] of its cells' bounding box (cells grow by concatenation only)."""
+        if self._box[0] != len(self.cells):
+            self._box = (len(self.cells), self.cells.min(axis=0), self.cells.max(axis=0))
+        return self._box[1], self._box[2]
 
 
 def _near_fraction(a: np.ndarray, b: np.ndarray, distance: float) -> float:
@@ -90,12 +97,16 @@ class ExploreState:
         return sum(int(p[2]) for p in self.places
                    if math.hypot(p[0] - goal[0], p[1] - goal[1]) < self.blacklist_radius)
 
-    def _same_place(self, b: Blacklisted, f: Frontier) -> bool:
+    def _same_place(self, b: Blacklisted, f: Frontier, near_goal: Optional[bool] = None) -> bool:
+        """`near_goal`: whether f's goal lies within blacklist_radius of one of b's goals, if the
+        caller knows (screen works it out for all places at once)."""
         if b.cells is None:
             return False
         # A goal near a failed one is the same place; near a reached one it may see more: there
         # only the same cells make the same frontier.
-        if not b.reached and any(math.hypot(f.goal[0] - x, f.goal[1] - y) < self.blacklist_radius for x, y in b.goals):
+        if near_goal is None:
+            near_goal = any(math.hypot(f.goal[0] - x, f.goal[1] - y) < self.blacklist_radius for x, y in b.goals)
+        if not b.reached and near_goal:
             return True
         return (_near_fraction(f.cells, b.cells, 0.3) >= self.same_frontier_overlap or
                 _near_fraction(b.cells, f.cells, 0.3) >= self.same_frontier_overlap)
@@ -110,6 +121,13 @@ class ExploreState:
         stamp of the map the frontiers come from); until then it waits, settle_time at most."""
         eligible, waiting, given_up = [], 0, []
         failures = [b for b in self.blacklist if b.cells is not None]
+        # Which places can be f's at all, for all places at once (a building's exploration records
+        # hundreds): the cells' boxes within 0.3 m of each other, or a goal within blacklist_radius.
+        if failures:
+            boxes = [b.box() for b in failures]
+            lo, hi = np.array([bx[0] for bx in boxes]), np.array([bx[1] for bx in boxes])
+            goals = np.array([g for b in failures for g in b.goals], float).reshape(-1, 2)
+            owner = np.repeat(np.arange(len(failures)), [len(b.goals) for b in failures])
         for f in frontiers:
             sent = self._goals_sent_near(f.goal)
             if sent >= self.max_goals_per_place:
@@ -118,7 +136,14 @@ class ExploreState:
                 x, y = f.cells.mean(axis=0)
                 given_up.append(GivenUp(float(x), float(y), f.size_m, 'sent %d times and never explored' % sent))
                 continue
-            matches = [b for b in failures if self._same_place(b, f)]
+            matches = []
+            if failures:
+                flo, fhi = f.cells.min(axis=0), f.cells.max(axis=0)
+                overlap = ~(np.any(flo > hi + 0.3, axis=1) | np.any(lo > fhi + 0.3, axis=1))
+                near_goal = np.zeros(len(failures), bool)
+                near_goal[owner[np.hypot(goals[:, 0] - f.goal[0], goals[:, 1] - f.goal[1]) < self.blacklist_radius]] = True
+                matches = [failures[i] for i in np.flatnonzero(overlap | near_goal)
+                           if self._same_place(failures[i], f, bool(near_goal[i]))]
             # with no newer map within settle_time (SLAM publishes none while the robot stands
             # still), it is judged on the map there is
             unsettled = [b for b in matches if b.reached and map_time <= b.until and now - b.until < self.settle_time]

@@ -123,15 +123,20 @@ def _longest_piece(mask: np.ndarray) -> float:
     return float(np.max(np.hypot(stats[1:, 2], stats[1:, 3]))) if n > 1 else 0.0
 
 
-def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int) -> List[np.ndarray]:
+def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells: int = 1) -> List[np.ndarray]:
+    """The frontiers of at least min_cells cells, largest first (a large map has thousands of
+    one- and two-cell fragments: they are counted, not listed)."""
     data = m.data.astype(np.int16)
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
-    n, labels = cv2.connectedComponents(frontier, connectivity=8)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(frontier, connectivity=8)
     # one pass over the labelled cells, split by label (not one scan of the grid per group)
     rows, cols = np.nonzero(labels)
     lab = labels[rows, cols]
+    if min_cells > 1:
+        big = stats[lab, cv2.CC_STAT_AREA] >= min_cells
+        rows, cols, lab = rows[big], cols[big], lab[big]
     order = np.argsort(lab, kind='stable')
     rows, cols, lab = rows[order], cols[order], lab[order]
     splits = np.flatnonzero(np.diff(lab)) + 1
@@ -230,20 +235,18 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             br, bc = costmap.cell_of(gx, gy)
             cv2.circle(blocked, (int(bc), int(br)), r, 1, -1)
         goal_ok = reach_ok & (blocked == 0)
-    k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1
-    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1  # the window of cells within goal_reach
     avoid = np.asarray(avoid, float).reshape(-1, 2)
     kr, kc = costmap.cell_of(*keep_goal) if keep_goal is not None else (-1, -1)
     unknown = unknown_space(m, occupied_min, min_unknown_area)
     g_reach = int(math.ceil(GAIN_RADIUS / m.resolution))
-    g_disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * g_reach + 1, 2 * g_reach + 1))
     # beyond the grid's edge is unknown too (the SLAM map grows as the robot sees more)
     unknown_beyond = cv2.copyMakeBorder(unknown, g_reach, g_reach, g_reach, g_reach, cv2.BORDER_CONSTANT, value=1)
     out = []
-    for g in _frontier_groups(m, unknown, occupied_min):
+    for g in _frontier_groups(m, unknown, occupied_min, max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9)))):
+        if len(g) * m.resolution < min_frontier_size:
+            break  # the groups come largest first: the rest are smaller still
         x, y = m.centre_of(g[:, 0], g[:, 1])
-        if len(x) * m.resolution < min_frontier_size:
-            continue
         if len(avoid):
             keep = np.min(np.hypot(x[:, None] - avoid[None, :, 0], y[:, None] - avoid[None, :, 1]), axis=1) >= avoid_radius
             if keep.sum() * m.resolution < min_frontier_size:
@@ -257,10 +260,10 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
         # unknown_beyond's cell (r + g_reach, c + g_reach) is the map's (r, c))
         ur0, uc0 = int(g[:, 0].min()), int(g[:, 1].min())
         ur1, uc1 = int(g[:, 0].max()) + 2 * g_reach + 1, int(g[:, 1].max()) + 2 * g_reach + 1
-        cells = np.zeros((ur1 - ur0, uc1 - uc0), np.uint8)
-        cells[g[:, 0] - ur0 + g_reach, g[:, 1] - uc0 + g_reach] = 1
-        unknown_m2 = float(np.count_nonzero((cv2.dilate(cells, g_disc) > 0) & (unknown_beyond[ur0:ur1, uc0:uc1] > 0))
-                           ) * m.resolution ** 2
+        others = np.ones((ur1 - ur0, uc1 - uc0), np.uint8)  # 0 on its cells: distances from them
+        others[g[:, 0] - ur0 + g_reach, g[:, 1] - uc0 + g_reach] = 0
+        within = cv2.distanceTransform(others, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= g_reach
+        unknown_m2 = float(np.count_nonzero(within & (unknown_beyond[ur0:ur1, uc0:uc1] > 0))) * m.resolution ** 2
         size = len(x) * m.resolution
         if unknown_m2 < min_unknown_beside:
             # a sliver the laser grazed: a trip there shows next to nothing (measured: the office's
@@ -278,9 +281,10 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
         r1, c1 = min(int(cr.max()) + half + 1, cost.shape[0]), min(int(cc.max()) + half + 1, cost.shape[1])
         candidates = reachable = np.zeros((max(r1 - r0, 0), max(c1 - c0, 0)), bool)
         if inside.any() and candidates.size:
-            near = np.zeros(candidates.shape, np.uint8)
-            near[cr[inside] - r0, cc[inside] - c0] = 1
-            reachable = (cv2.dilate(near, disc) > 0) & reach_ok[r0:r1, c0:c1]
+            far = np.ones(candidates.shape, np.uint8)  # 0 on the frontier's cells
+            far[cr[inside] - r0, cc[inside] - c0] = 0
+            near = cv2.distanceTransform(far, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= half
+            reachable = near & reach_ok[r0:r1, c0:c1]
             candidates = reachable & goal_ok[r0:r1, c0:c1]
         if not candidates.any():
             if unreachable is not None:
