@@ -185,7 +185,9 @@ def saved_map(tmp_path, name='room'):
 def test_a_saved_map_is_a_world(tmp_path):
     w = load_world(saved_map(tmp_path))
     (s,) = w.shapes
-    assert s.kind == 'grid' and (s.x, s.y) == (-1.0, -0.5) and s.cells.shape == (40, 60)
+    # a frame of solid cells around the image: beyond a saved map is solid too
+    assert s.kind == 'grid' and (s.x, s.y) == pytest.approx((-1.05, -0.55)) and s.cells.shape == (42, 62)
+    assert s.cells[0].all() and s.cells[-1].all() and s.cells[:, 0].all() and s.cells[:, -1].all()
     sim = Simulation(w, slip_stddev=0.0)
     r = sim.spawn('r', robot(), (0.5, 0.5, 0.0))
     ranges = sim.scan(r, r.lasers[0])
@@ -194,7 +196,16 @@ def test_a_saved_map_is_a_world(tmp_path):
     truth, origin = rasterize(w, 0.05, margin=0.0)
     assert (truth > 0).sum() == (s.cells > 0).sum()  # the same cells, on the same grid
     free_outside = load_world(saved_map(tmp_path), map_unknown='free')
-    assert free_outside.shapes[0].cells.sum() == 2 * 50 + 2 * 28
+    assert free_outside.shapes[0].cells.shape == (40, 60) and free_outside.shapes[0].cells.sum() == 2 * 50 + 2 * 28
+
+
+def test_a_map_cropped_through_a_room_keeps_the_robot_in(tmp_path):
+    data = np.zeros((20, 40), np.int8)  # 2 x 1 m of floor, open at every edge
+    save_map(str(tmp_path / 'cropped'), data, 0.05, (0.0, 0.0, 0.0))
+    sim = Simulation(load_world(str(tmp_path / 'cropped.yaml')), slip_stddev=0.0)
+    r = sim.spawn('r', robot(), (0.5, 0.5, 0.0))
+    run(sim, 'r', 0.5, 6.0)
+    assert r.collisions == 1 and r.pose[0] < 2.0  # stopped at the image's edge
 
 
 def test_spawning_outside_a_saved_map_is_refused_with_a_free_place(tmp_path):

@@ -2,10 +2,15 @@
 
 The map is read as map_server reads it (maps/map_io.load_map: image, resolution, origin, negate,
 occupied_thresh, free_thresh, mode), and becomes one grid shape: occupied cells are walls of every
-height (raw mode: values from occupied_thresh x 100 to 100); unknown cells are walls too by default (a saved map's outside, beyond which the laser saw
-nothing), or free floor with map_unknown='free'. The grid sits where map_server puts the map: the
-lower-left pixel's corner at origin (x, y), turned by origin's yaw; map frame = world frame.
+height (raw mode: values from occupied_thresh x 100 to 100); unknown cells are walls too by default
+(a saved map's outside, beyond which the laser saw nothing), or free floor with map_unknown='free'.
+With unknown cells solid, so is the world beyond the image: a frame of one solid cell surrounds it
+(a map cropped through a room does not let the robot out into endless floor). The grid sits where
+map_server puts the map: the lower-left pixel's corner at origin (x, y), turned by origin's yaw; map
+frame = world frame.
 """
+import math
+
 import numpy as np
 
 from mbot_slam_navigation.maps.map_io import MapFileError, load_map
@@ -30,5 +35,9 @@ def load_map_world(yaml_path: str, map_unknown: str = 'solid') -> World:
     if not solid.any() and map_unknown == 'free':
         raise MapFileError(yaml_path, 'has no occupied cell: nothing to simulate', 'image')
     x, y, yaw = m.origin
+    if map_unknown == 'solid':
+        solid = np.pad(solid, 1, constant_values=True)
+        r = m.resolution  # the origin moves one cell down and left, along the map's own axes
+        x, y = x - r * (math.cos(yaw) - math.sin(yaw)), y - r * (math.sin(yaw) + math.cos(yaw))
     name = yaml_path.rsplit('/', 1)[-1]
     return World(name=name, shapes=[Shape('grid', x, y, yaw, cells=solid, resolution=m.resolution, name=name)])
