@@ -225,3 +225,11 @@ def test_bad_maps_name_the_file_and_key(tmp_path):
         load_world(str(tmp_path / 'noimage.yaml'))
     with pytest.raises(MapFileError, match=r"key 'map_unknown'"):
         load_world(path, map_unknown='maybe')
+
+
+def test_ground_truth_of_a_world_that_cannot_be_read_is_left_out_with_why(tmp_path):
+    from mbot_slam_navigation.sim.ground_truth import load_truth
+    world, why = load_truth(str(tmp_path / 'gone.world'))
+    assert world is None and 'gone.world does not exist' in why
+    world, why = load_truth(saved_map(tmp_path), 'solid', ROBOT)
+    assert why is None and world.shapes[0].kind == 'grid'

@@ -69,8 +69,7 @@ from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
 from mbot_slam_navigation.nav.tour import GoalFields, tour_order
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
-from mbot_slam_navigation.sim.sdf_world import load_world
-from mbot_slam_navigation.sim.ground_truth import as_the_robot_meets_it
+from mbot_slam_navigation.sim.ground_truth import load_truth
 from mbot_slam_navigation.topic_watch import WatchedSubscriber
 from mbot_slam_navigation.transforms import compose2d, inverse2d, quaternion_to_yaw
 
@@ -341,9 +340,9 @@ class Explore:
         or None when there is no world file."""
         if not (self.world_name and os.path.isfile(self.world_name)):
             return None
-        world = load_world(self.world_name, rospy.get_param('/gazebo/map_unknown', 'solid'))
         key = rospy.search_param('robot_description')
-        world, warning = as_the_robot_meets_it(world, rospy.get_param(key, '') if key else None, key or '')
+        world, warning = load_truth(self.world_name, rospy.get_param('/gazebo/map_unknown', 'solid'),
+                                    rospy.get_param(key, '') if key else None, key or '')
         if warning:
             rospy.logwarn('explore: %s' % warning)
         return world

@@ -39,6 +39,18 @@ def as_the_robot_meets_it(world: World, urdf_text: Optional[str], source: str = 
     return world.blocking(GROUND_CLEARANCE, height), None
 
 
+def load_truth(world_file: str, map_unknown: str = 'solid', urdf_text: Optional[str] = None,
+               source: str = 'robot_description') -> Tuple[Optional[World], Optional[str]]:
+    """(the world as a robot of this URDF meets it, a warning or None) for ground-truth figures; (None,
+    why) when the world file cannot be read: the figures are then left out, the run's report is not."""
+    from mbot_slam_navigation.sim.sdf_world import load_world
+    try:
+        world = load_world(world_file, map_unknown)
+    except ValueError as e:  # XmlError, MapFileError
+        return None, 'no ground truth: %s' % e
+    return as_the_robot_meets_it(world, urdf_text, source)
+
+
 def _extent(world: World, points: Optional[np.ndarray], margin: float) -> Tuple[float, float, float, float]:
     b = world.bounds()
     boxes = [] if b is None else [b]
