@@ -48,3 +48,25 @@ def test_a_perfect_map_scores_full_and_half_a_map_half(world, tmp_path):
     assert 0.4 < g['coverage_of_reachable_free'] < 0.6
     wrong = Grid(m.data.copy(), m.resolution, (m.origin[0] + 0.3, m.origin[1] + 0.3))  # walls 0.3 m off
     assert write_report(str(tmp_path / 'off'), wrong, [], [], [], {}, world)['walls_within_tolerance'] < 0.2
+
+
+def test_a_map_made_from_a_spawn_away_from_the_origin_is_scored_in_the_world_frame(world, tmp_path):
+    """A robot spawned at (1, -2) facing +y: its SLAM map (frame at the spawn pose) is the world turned
+    by -90 degrees and moved; with the spawn pose the report scores it as the perfect map it is."""
+    import cv2
+    from mbot_slam_navigation.explore_report import map_in_world
+    truth = perfect_map(world)
+    spawn = (1.0, -2.0, np.pi / 2)
+    # the same cells seen from the map frame: world (x, y) = spawn + R(90) (u, v), so u = y + 2, v = 1 - x
+    turned = cv2.rotate(truth.data.astype(np.int16), cv2.ROTATE_90_COUNTERCLOCKWISE).astype(np.int8)
+    h, w = truth.data.shape
+    x0, y0 = truth.origin
+    seen = Grid(turned, 0.05, (y0 + 2.0, 1.0 - (x0 + w * 0.05)))
+    back = map_in_world(seen, spawn)
+    assert back.origin == pytest.approx(truth.origin, abs=0.051) and back.data.shape[0] in (h, h + 1)
+    start = (0.0, 0.0)  # the spawn, in the map frame
+    figures = write_report(str(tmp_path), seen, [start], [], [(0.0, 0.0)], {}, world, start, 0.2,
+                           world_from_map=spawn)
+    assert figures['walls_within_tolerance'] == 1.0 and figures['coverage_of_reachable_free'] > 0.99
+    unmoved = write_report(str(tmp_path), seen, [start], [], [(0.0, 0.0)], {}, world, start, 0.2)
+    assert unmoved['walls_within_tolerance'] < 0.5  # scored without the spawn pose: wrong
