@@ -41,6 +41,10 @@ def estimated_poses(slam, scans) -> np.ndarray:
     return per_scan_poses(slam.trajectory(), scans)
 
 
+class BagError(ValueError):
+    """A bag that cannot be read; the message names the file and what is wrong."""
+
+
 def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
     """Scans from a bag with their odometry at each scan's stamp, interpolated between the odom
     messages either side of it (by their stamps, not the order the bag holds them in: a bag
@@ -48,15 +52,24 @@ def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
     odometry's span, or in a gap of it longer than 0.5 s, are left out."""
     import rosbag  # only needed for bags
     from mbot_slam_navigation.slam.carmen import Scan
+    with open(path, 'rb') as f:
+        head = f.read(13)
+    if not head.startswith(b'#ROSBAG V2.0'):
+        raise BagError('%s: not a rosbag: expected the header "#ROSBAG V2.0", found %s' % (
+            path, repr(head.decode('ascii')) if head.isascii() and head.decode('ascii').isprintable() else
+            'bytes ' + head[:8].hex(' ')))
     odom, raw = [], []
-    with rosbag.Bag(path) as bag:
-        for topic, msg, _ in bag.read_messages(topics=[scan_topic, odom_topic]):
-            if topic == odom_topic:
-                p = msg.pose.pose
-                odom.append((msg.header.stamp.to_sec(), p.position.x, p.position.y,
-                             quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)))
-            else:
-                raw.append(msg)
+    try:
+        with rosbag.Bag(path) as bag:
+            for topic, msg, _ in bag.read_messages(topics=[scan_topic, odom_topic]):
+                if topic == odom_topic:
+                    p = msg.pose.pose
+                    odom.append((msg.header.stamp.to_sec(), p.position.x, p.position.y,
+                                 quaternion_to_yaw(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)))
+                else:
+                    raw.append(msg)
+    except (rosbag.ROSBagException, UnicodeDecodeError, ValueError) as e:
+        raise BagError('%s: the bag cannot be read: %s' % (path, e)) from None
     if not odom or not raw:
         return []
     odom = np.array(sorted(odom))
@@ -152,7 +165,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if not os.path.isfile(args.log):
         ap.error('log file %s does not exist' % args.log)
-    scans = read_rosbag(args.log) if args.log.endswith('.bag') else read_log(args.log)
+    try:
+        scans = read_rosbag(args.log) if args.log.endswith('.bag') else read_log(args.log)
+    except ValueError as e:  # CarmenError, BagError: the file and what is wrong with it
+        ap.exit(2, 'slam_offline: %s\n' % e)
     params = dict(args.param)
     try:
         slam, cpu = run(scans, params, progress=not args.quiet, backend=args.backend)
