@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from mbot_slam_navigation.slam.carmen import CarmenError, read_log
+from mbot_slam_navigation.slam.offline import BagError, read_rosbag
 from mbot_slam_navigation.slam.relations import evaluate, pose_at
 from mbot_slam_navigation.transforms import compose2d, relative2d
 
@@ -291,26 +292,17 @@ def test_run_fed_at_a_rate_keeps_each_scans_pose_as_processed(backend):
     assert np.allclose(flat, online, atol=1e-6)  # pacing changes when, not what
 
 
-def test_files_that_are_no_log_say_what_was_expected_and_found(tmp_path):
-    from mbot_slam_navigation.slam.offline import BagError, read_rosbag
-    binary = tmp_path / 'photo.clf'
-    binary.write_bytes(bytes(range(256)) * 4)
-    with pytest.raises(CarmenError, match=r'photo.clf: not a CARMEN log: expected text lines .*found binary data '
-                                          r'\(first bytes 00 01 02'):
-        read_log(str(binary))
-    broken = tmp_path / 'log.clf.bz2'
-    broken.write_bytes(b'not bzip2 at all')
-    with pytest.raises(CarmenError, match=r'log.clf.bz2: cannot be read as a bzip2 file'):
-        read_log(str(broken))
-    bag_named_log = tmp_path / 'run.clf'
-    bag_named_log.write_bytes(b'#ROSBAG V2.0\n' + bytes(100))
-    with pytest.raises(CarmenError, match='is a rosbag, not a CARMEN log'):
-        read_log(str(bag_named_log))
-    text_named_bag = tmp_path / 'run.bag'
-    text_named_bag.write_text('FLASER 3 1 2 3 0 0 0 0 0 0 1.0\n')
-    with pytest.raises(BagError, match=r"run.bag: not a rosbag: expected the header \"#ROSBAG V2.0\", found 'FLASER"):
-        read_rosbag(str(text_named_bag))
-    truncated = tmp_path / 'cut.bag'
-    truncated.write_bytes(b'#ROSBAG V2.0\n' + bytes(50))
-    with pytest.raises(BagError, match='cut.bag: the bag cannot be read'):
-        read_rosbag(str(truncated))
+@pytest.mark.parametrize('name, content, reader, error, message', [
+    ('photo.clf', bytes(range(256)) * 4, read_log, CarmenError,
+     r'photo.clf: not a CARMEN log: expected text lines .*found binary data \(first bytes 00 01 02'),
+    ('log.clf.bz2', b'not bzip2 at all', read_log, CarmenError, r'log.clf.bz2: cannot be read as a bzip2 file'),
+    ('run.clf', b'#ROSBAG V2.0\n' + bytes(100), read_log, CarmenError, 'is a rosbag, not a CARMEN log'),
+    ('run.bag', b'FLASER 3 1 2 3 0 0 0 0 0 0 1.0\n', read_rosbag, BagError,
+     r"run.bag: not a rosbag: expected the header \"#ROSBAG V2.0\", found 'FLASER"),
+    ('cut.bag', b'#ROSBAG V2.0\n' + bytes(50), read_rosbag, BagError, 'cut.bag: the bag cannot be read'),
+])
+def test_files_that_are_no_log_say_what_was_expected_and_found(tmp_path, name, content, reader, error, message):
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(error, match=message):
+        reader(str(path))

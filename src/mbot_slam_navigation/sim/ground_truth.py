@@ -16,7 +16,10 @@ import cv2
 import numpy as np
 
 from mbot_slam_navigation.maps.map_io import SAVER_OCCUPIED
-from mbot_slam_navigation.sim.sdf_world import World
+from mbot_slam_navigation.sim.sdf_world import World, load_world
+from mbot_slam_navigation.sim.simulation import GROUND_CLEARANCE
+from mbot_slam_navigation.sim.urdf_robot import parse_urdf
+from mbot_slam_navigation.sim.xmlutil import XmlError
 
 SURFACE_RESOLUTION = 0.02  # [m] raster of distance_to_surfaces: distances within about 0.015 m
 _SHIFT = 8                 # sub-pixel bits of OpenCV's drawing
@@ -27,9 +30,6 @@ def as_the_robot_meets_it(world: World, urdf_text: Optional[str], source: str = 
     """(the world's shapes that a robot of this URDF meets, a warning or None): those overlapping its
     body from GROUND_CLEARANCE to the top of its collision geometry, as the simulator decides. Without
     a URDF, or with one that cannot be read (the warning says why), every shape counts."""
-    from mbot_slam_navigation.sim.simulation import GROUND_CLEARANCE
-    from mbot_slam_navigation.sim.urdf_robot import parse_urdf
-    from mbot_slam_navigation.sim.xmlutil import XmlError
     if not urdf_text:
         return world, None
     try:
@@ -43,7 +43,6 @@ def load_truth(world_file: str, map_unknown: str = 'solid', urdf_text: Optional[
                source: str = 'robot_description') -> Tuple[Optional[World], Optional[str]]:
     """(the world as a robot of this URDF meets it, a warning or None) for ground-truth figures; (None,
     why) when the world file cannot be read: the figures are then left out, the run's report is not."""
-    from mbot_slam_navigation.sim.sdf_world import load_world
     try:
         world = load_world(world_file, map_unknown)
     except ValueError as e:  # XmlError, MapFileError

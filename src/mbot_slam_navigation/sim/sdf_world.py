@@ -188,7 +188,8 @@ def find_model(name: str) -> Optional[str]:
         config = os.path.join(d, 'model.config')
         if os.path.isfile(config):
             try:
-                root, _ = parse_xml(open(config, encoding='utf-8').read(), config)
+                with open(config, encoding='utf-8') as f:
+                    root, _ = parse_xml(f.read(), config)
                 files = sorted(root.findall('sdf'), key=lambda e: [int(v) for v in e.get('version', '0').split('.')
                                                                    if v.isdigit()])
                 if files and files[-1].text and os.path.isfile(os.path.join(d, files[-1].text.strip())):
