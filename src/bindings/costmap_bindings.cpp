@@ -186,6 +186,30 @@ void bindCostmaps(py::module& m) {
       },
       py::arg("passable"), py::arg("col"), py::arg("row"));
   m.def(
+      "_path_lengths_between",
+      [](py::array_t<uint8_t, py::array::c_style | py::array::forcecast> passable,
+         py::array_t<int, py::array::c_style | py::array::forcecast> rows,
+         py::array_t<int, py::array::c_style | py::array::forcecast> cols) {
+        if (passable.ndim() != 2) throw std::invalid_argument("_path_lengths_between: passable must be a 2D array");
+        if (rows.ndim() != 1 || cols.ndim() != 1 || rows.size() != cols.size()) {
+          throw std::invalid_argument("_path_lengths_between: rows and cols must be 1D arrays of one length");
+        }
+        const int h = static_cast<int>(passable.shape(0)), w = static_cast<int>(passable.shape(1));
+        std::vector<uint8_t> grid(passable.data(), passable.data() + passable.size());
+        std::vector<mbot::core::Cell> cells;
+        for (py::ssize_t i = 0; i < rows.size(); ++i) cells.push_back(mbot::core::Cell{cols.at(i), rows.at(i)});
+        std::vector<double> d;
+        {
+          py::gil_scoped_release release;
+          d = mbot::core::pathLengthsBetween(grid, w, h, cells);
+        }
+        const py::ssize_t n = static_cast<py::ssize_t>(cells.size());
+        py::array_t<double> out({n, n});
+        std::copy(d.begin(), d.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("passable"), py::arg("rows"), py::arg("cols"));
+  m.def(
       "_shortest_paths_through_all",
       [](py::array_t<double, py::array::c_style | py::array::forcecast> d, int exact_max) {
         if (d.ndim() != 2 || d.shape(0) != d.shape(1)) {

@@ -10,7 +10,7 @@ from mbot_slam_navigation import _core
 from mbot_slam_navigation.nav.explore_state import ExploreState
 from mbot_slam_navigation.nav.frontiers import Frontier, GivenUp, Grid, frontier_groups, rank_frontiers
 from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
-from mbot_slam_navigation.nav.tour import GoalFields, tour_order
+from mbot_slam_navigation.nav.tour import tour_order
 
 RES = 0.05
 
@@ -484,29 +484,21 @@ def test_the_tour_takes_a_small_frontier_behind_the_robot_before_twelve_larger_o
     assert tour_order([behind] + ahead, passable, grid, size=8)[0].goal != behind.goal
 
 
-def test_goal_fields_are_reused_while_they_serve():
-    passable = np.zeros((20, 220), np.uint8)
-    passable[5:15, 5:215] = 1
+def test_the_tour_measures_the_way_round_a_wall_not_the_straight_line():
+    # Two goals 1 m apart on either side of a wall that ends 2 m up: the way round is about 4.6 m.
+    passable = np.zeros((60, 200), np.uint8)
+    passable[5:55, 5:195] = 1
+    passable[:45, 98:102] = 0  # the wall, 0.2 m thick, from the floor's edge to y = 2.25 m
     grid = Grid(passable.astype(np.int8), RES, (0.0, 0.0))
-    frontiers = [_frontier_at(x, 0.5, abs(x - 5.0), size_m=1.0) for x in (2.0, 6.0, 9.0)]
-    fields = GoalFields(max_age=10.0, reuse_m=0.3)
-    first = tour_order(frontiers, passable, grid, fields=fields, now=0.0)
-    assert fields.computed == 3
-    # the same goals 3 s later, and one moved 0.2 m with its frontier: nothing new to compute,
-    # the same order as fresh fields give
-    moved = frontiers[:2] + [_frontier_at(9.2, 0.5, 4.2, size_m=1.0)]
-    again = tour_order(moved, passable, grid, fields=fields, now=3.0)
-    assert fields.computed == 3
-    assert [f.goal for f in again] == [f.goal for f in tour_order(moved, passable, grid)]
-    assert [f.goal for f in first][:2] == [f.goal for f in again][:2]
-    # a goal 1 m from any computed one gets its own field; after max_age all are computed anew
-    tour_order(frontiers[:2] + [_frontier_at(8.0, 0.5, 3.0, size_m=1.0)], passable, grid, fields=fields, now=4.0)
-    assert fields.computed == 4
-    tour_order(frontiers, passable, grid, fields=fields, now=15.0)
-    assert fields.computed == 7
-    # the clock went back (a simulation reset): nothing from before is used
-    tour_order(frontiers, passable, grid, fields=fields, now=1.0)
-    assert fields.computed == 10
+    a, b = _frontier_at(4.45, 0.5, 1.0, size_m=1.0), _frontier_at(5.55, 0.5, 6.0, size_m=1.0)
+    toured = {f.goal: f.cost for f in tour_order([a, b], passable, grid, potential_scale=1.0)}
+    way = toured[a.goal] - a.cost  # the tour from a on: a to b
+    assert 4.0 < way < 5.0
+    assert toured[b.goal] - b.cost == pytest.approx(way)
+    # a goal off the grid (from a costmap of another cycle): no path known; via the robot
+    off = _frontier_at(50.0, 0.5, 8.0, size_m=1.0)
+    toured = {f.goal: f.cost for f in tour_order([a, off], passable, grid, potential_scale=1.0)}
+    assert toured[a.goal] - a.cost == pytest.approx(1.0 + 8.0)
 
 
 def test_a_team_shares_the_frontiers_out():
@@ -553,3 +545,57 @@ def test_the_goal_being_driven_to_stays_the_frontiers_goal_while_it_is_still_val
     assert kept.goal == south and kept.path_m > rank_frontiers(m, c, (4.2, 3.5))[0].path_m
     # a goal that is no cell of the frontier any more (inside the room, far from it) is not kept
     assert rank_frontiers(m, c, (4.2, 3.5), keep_goal=(2.0, 2.0))[0].goal == north
+
+
+def _hall_with_doors(seed=3, doors=12):
+    """A known 20 x 12 m hall walled round, inside an unknown 24 x 16 m grid, with `doors` 1 m gaps
+    in its walls at seeded places, each a frontier to the unknown beyond."""
+    rng = np.random.default_rng(seed)
+    g = np.full((int(16 / RES), int(24 / RES)), -1, np.int8)
+    r0, c0, r1, c1 = int(2 / RES), int(2 / RES), int(14 / RES), int(22 / RES)
+    g[r0:r1 + 1, c0:c1 + 1] = 100
+    g[r0 + 1:r1, c0 + 1:c1] = 0
+    for k in range(doors):
+        n = 20  # cells: 1 m
+        if k % 2:  # north or south wall
+            c = int(rng.integers(c0 + 1, c1 - n)) // 40 * 40 + c0 + 10
+            g[r0 if k % 4 == 1 else r1, c:c + n] = 0
+        else:      # west or east wall
+            r = int(rng.integers(r0 + 1, r1 - n)) // 40 * 40 + r0 + 10
+            g[r:r + n, c0 if k % 4 == 0 else c1] = 0
+    return Grid(g, RES, (0.0, 0.0))
+
+
+def test_ranking_only_the_best_gives_them_as_ranking_all_does():
+    m = _hall_with_doors()
+    c = costmap_of(m)
+    robot = (3.0, 3.0)
+    everything = rank_frontiers(m, c, robot, min_frontier_size=0.5)
+    assert len(everything) >= 8
+    for enough in (1, 3, 5):
+        stats = {}
+        best = rank_frontiers(m, c, robot, min_frontier_size=0.5, enough=enough, stats=stats)
+        assert [(f.goal, f.cost) for f in best[:enough]] == [(f.goal, f.cost) for f in everything[:enough]]
+        assert len(best) + len(stats['unranked']) == len(everything)
+        assert len(stats['unranked']) > 0  # the far ones were left
+    # the frontier of the goal being driven to is ranked however far it is
+    far = everything[-1]
+    stats = {}
+    best = rank_frontiers(m, c, robot, min_frontier_size=0.5, enough=1, keep_goal=far.goal, stats=stats)
+    assert far.goal in [f.goal for f in best]
+    # those that may not be sent do not count towards `enough`
+    not_first = rank_frontiers(m, c, robot, min_frontier_size=0.5, enough=1,
+                               eligible=lambda f: f.goal != everything[0].goal)
+    assert [f.goal for f in not_first[:2]] == [f.goal for f in everything[:2]]
+
+
+def test_a_map_allocated_larger_than_what_is_known_gives_the_same_frontiers():
+    # SLAM allocates its map beyond what the robot has seen; the search is cut to the known part
+    m = room(door=(1.0, 2.0))
+    big = Grid(np.pad(m.data, ((100, 300), (200, 40)), constant_values=-1), RES, (-200 * RES, -100 * RES))
+    a = rank_frontiers(m, costmap_of(m), (2.0, 2.0), min_frontier_size=0.5)
+    stats = {}
+    b = rank_frontiers(big, costmap_of(big), (2.0, 2.0), min_frontier_size=0.5, stats=stats)
+    assert [(f.goal, f.cost, f.unknown_m2) for f in a] == [(pytest.approx(f.goal), pytest.approx(f.cost),
+                                                            pytest.approx(f.unknown_m2)) for f in b]
+    assert stats['costmap'].data.shape[0] < big.data.shape[0] and stats['costmap'].data.shape[1] < big.data.shape[1]

@@ -8,6 +8,7 @@
 
 using mbot::core::Cell;
 using mbot::core::pathLengths;
+using mbot::core::pathLengthsBetween;
 
 TEST(PathLengths, OpenGridGivesOctileDistances) {
   std::vector<uint8_t> free(10 * 8, 1);
@@ -55,4 +56,37 @@ TEST(PathLengths, BadInputIsRefusedWithTheReason) {
   std::vector<uint8_t> g(6, 1);
   EXPECT_THROW(pathLengths(g, 4, 2, Cell{0, 0}), std::invalid_argument);
   EXPECT_THROW(pathLengths(g, 3, 2, Cell{3, 0}), std::invalid_argument);
+}
+
+TEST(PathLengthsBetween, MatchesTheFullSearchWhereverTheSearchesStop) {
+  // A floor with walls and a closed room; cells near each other and far apart.
+  const int w = 60, h = 40;
+  std::vector<uint8_t> g(w * h, 1);
+  for (int y = 0; y < 30; ++y) g[y * w + 20] = 0;       // a wall with a way round at the top
+  for (int x = 40; x < 50; ++x) g[10 * w + x] = g[20 * w + x] = 0;  // a closed room
+  for (int y = 10; y <= 20; ++y) g[y * w + 40] = g[y * w + 49] = 0;
+  const std::vector<Cell> cells = {{2, 2}, {3, 2}, {30, 5}, {58, 38}, {45, 15}, {2, 2}};
+  const auto d = pathLengthsBetween(g, w, h, cells);
+  const std::size_t n = cells.size();
+  ASSERT_EQ(d.size(), n * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto full = pathLengths(g, w, h, cells[i]);
+    for (std::size_t j = 0; j < n; ++j) {
+      EXPECT_DOUBLE_EQ(d[i * n + j], d[j * n + i]);
+      EXPECT_NEAR(d[i * n + j], full[cells[j].y * w + cells[j].x], 1e-4) << i << " -> " << j;
+    }
+  }
+  EXPECT_DOUBLE_EQ(d[0 * n + 5], 0.0);   // the same cell twice
+  EXPECT_DOUBLE_EQ(d[0 * n + 1], 1.0);   // neighbours
+  EXPECT_EQ(d[0 * n + 4], -1.0);         // inside the closed room
+  EXPECT_GT(d[0 * n + 2], 28.0 + 20.0);  // round the wall
+}
+
+TEST(PathLengthsBetween, CountsItsCellsPassable) {
+  std::vector<uint8_t> g(5 * 1, 1);
+  g[4] = 0;  // a goal on a blocked cell at the end of a corridor
+  const auto d = pathLengthsBetween(g, 5, 1, {Cell{0, 0}, Cell{4, 0}});
+  EXPECT_DOUBLE_EQ(d[1], 4.0);
+  EXPECT_THROW(pathLengthsBetween(g, 5, 1, {Cell{5, 0}}), std::invalid_argument);
+  EXPECT_TRUE(pathLengthsBetween(g, 5, 1, {}).empty());
 }

@@ -17,5 +17,13 @@ namespace core {
 /// std::invalid_argument when `passable` has the wrong size or `start` lies outside the grid.
 std::vector<float> pathLengths(const std::vector<uint8_t>& passable, int width, int height, const Cell& start);
 
+/// The n x n matrix (row-major, [cells]) of path lengths between `cells` over the same grid, each
+/// of them counted passable: symmetric, 0 on the diagonal, -1 between cells not connected. Each
+/// search stops when the cells it is for are reached, so cells near each other cost little however
+/// large the grid. Throws std::invalid_argument when `passable` has the wrong size or a cell lies
+/// outside the grid.
+std::vector<double> pathLengthsBetween(const std::vector<uint8_t>& passable, int width, int height,
+                                       const std::vector<Cell>& cells);
+
 }  // namespace core
 }  // namespace mbot

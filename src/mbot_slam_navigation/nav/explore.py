@@ -39,7 +39,7 @@ import os
 import time
 import traceback
 from types import SimpleNamespace
-from typing import List, Optional, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 import rospy
@@ -62,11 +62,11 @@ from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
-from mbot_slam_navigation.nav.explore_state import ExploreState, MotionWatch, Plateau
+from mbot_slam_navigation.nav.explore_state import ELIGIBLE, ExploreState, MotionWatch, Plateau
 from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, POTENTIAL_SCALE, Frontier, GivenUp,
                                                 Grid, passable, rank_frontiers)
 from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
-from mbot_slam_navigation.nav.tour import GoalFields, tour_order
+from mbot_slam_navigation.nav.tour import tour_order
 from mbot_slam_navigation.nav.params import ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.ground_truth import load_truth
@@ -200,7 +200,6 @@ class Explore:
         self.min_frontier_size = c.min_frontier_size
         self.min_unknown_area, self.min_unknown_beside = c.min_unknown_area, c.min_unknown_beside
         self.tour_frontiers = c.tour_frontiers
-        self.goal_fields = GoalFields()  # tour_order's path lengths, kept between cycles
         self.visualize = c.visualize
         self.transform_tolerance = c.transform_tolerance
         self.state = ExploreState(progress_timeout=c.progress_timeout, blacklist_timeout=c.blacklist_timeout,
@@ -389,7 +388,9 @@ class Explore:
         g.target_pose.pose = pose_msg(x, y, yaw)
         self.move_base.send_goal(g)
 
-    def publish_markers(self, frontiers: List[Frontier]) -> None:
+    def publish_markers(self, frontiers: List[Frontier], unranked: Sequence[np.ndarray] = ()) -> None:
+        """The frontiers ranked (the best green, the others blue, each with its goal) and the cells
+        of those not ranked this cycle (grey: too far to be among the best)."""
         if not self.visualize or self.marker_pub.get_num_connections() == 0:
             return  # thousands of cells to build and send: only for someone who looks (rviz)
         out = MarkerArray()
@@ -411,6 +412,14 @@ class Explore:
             goal.scale.x = goal.scale.y = goal.scale.z = 0.15
             goal.color = colour
             out.markers += [cells, goal]
+        if len(unranked):
+            rest = Marker(type=Marker.POINTS, action=Marker.ADD, ns='frontiers_unranked', id=0)
+            rest.header.frame_id, rest.header.stamp = self.global_frame, now
+            rest.scale.x = rest.scale.y = self.map.resolution if self.map else 0.05
+            rest.color = ColorRGBA(0.5, 0.5, 0.5, 0.8)
+            rest.pose.orientation.w = 1.0
+            rest.points = [Point(x, y, 0.0) for c in unranked for x, y in c]
+            out.markers.append(rest)
         self.marker_pub.publish(out)
 
     def finish_goal(self, now: float) -> bool:
@@ -487,6 +496,11 @@ class Explore:
             if self.max_duration > 0 and now >= self.max_duration:
                 rospy.logwarn('explore: max_duration %.0f s reached with frontiers left; ending the exploration'
                               % self.max_duration)
+                pose = self.robot_pose()
+                if pose is not None and self.costmap is not None:
+                    # every frontier left, ranked, for the report's list of those given up
+                    m, m_stamp = self.map_with_stamp
+                    self.frontiers(now, m, m_stamp, self.costmap, pose, self.state.avoid(now), everything=True)
                 return 'timeout'
             pose = self.robot_pose()
             if pose is None:
@@ -546,9 +560,9 @@ class Explore:
                     self.move_base.cancel_goal()
                 frontiers, claimed = share_out(frontiers, mates, self.claim_radius, self.potential_scale)
             elif self.tour_frontiers >= 2 and 'passable' in stats:
-                frontiers = tour_order(frontiers, stats['passable'], costmap, self.potential_scale,
-                                       self.tour_frontiers, fields=self.goal_fields, now=now)
-            self.publish_markers(frontiers)
+                frontiers = tour_order(frontiers, stats['passable'], stats['costmap'], self.potential_scale,
+                                       self.tour_frontiers)
+            self.publish_markers(frontiers, stats.get('unranked', ()))
             self.plateau.update(now, explore_report.known_area(m), bool(frontiers) or self.state.goal is not None)
             new = self.state.choose(now, frontiers, pose[:2])
             self.tell_team(pose)
@@ -597,24 +611,33 @@ class Explore:
                 next_print = now + self.progress_period
                 print('explore: %.1f m^2 known, %d frontiers, %d goals sent (%d failed), robot at (%.2f, %.2f), '
                       '%.0f s simulated in %.0f s wall'
-                      % (explore_report.known_area(self.map), len(frontiers), self.state.goals_chosen,
+                      % (explore_report.known_area(self.map), len(frontiers) + len(stats.get('unranked', ())),
+                         self.state.goals_chosen,
                          self.goals_failed(), pose[0], pose[1], now, time.monotonic() - wall0), flush=True)
             self.wait_cycle()
         return None
 
-    def frontiers(self, now: float, m: Grid, m_stamp, costmap: Grid, pose, avoid) -> Tuple[List[Frontier], int, dict]:
+    def frontiers(self, now: float, m: Grid, m_stamp, costmap: Grid, pose, avoid,
+                  everything: bool = False) -> Tuple[List[Frontier], int, dict]:
         """(frontiers that may be sent now, best first; how many wait out a blacklisting; the
         ranking's stats), with the frontier cells near `avoid` left out; what is given up, and why,
-        goes to self.given_up (the report's list)."""
+        goes to self.given_up (the report's list). Only as many as the explorer uses are ranked
+        (stats['unranked']: the cells of those left), unless `everything`."""
         stats = {}
         unreachable: List[GivenUp] = []
+        map_time = (m_stamp - self.start_time).to_sec()
+        judge = self.state.screener(now, map_time)
+        # The best tour_frontiers that may be sent are what the explorer uses (all of them when
+        # sharing with a team, which takes some away; all when `everything`, for the report).
+        enough = 0 if self.team_pub is not None or everything else max(1, self.tour_frontiers)
         ranked = rank_frontiers(m, costmap, pose[:2], self.min_frontier_size, self.potential_scale,
                                 self.gain_scale, avoid, self.state.blacklist_radius,
                                 min_unknown_area=self.min_unknown_area, stats=stats,
                                 avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
                                 keep_goal=self.state.goal.goal if self.state.goal is not None else None,
-                                min_unknown_beside=self.min_unknown_beside, gain_size_max=self.gain_size_max)
-        frontiers, waiting, given_up = self.state.screen(now, ranked, (m_stamp - self.start_time).to_sec())
+                                min_unknown_beside=self.min_unknown_beside, gain_size_max=self.gain_size_max,
+                                enough=enough, eligible=lambda f: judge(f) is ELIGIBLE)
+        frontiers, waiting, given_up = self.state.screen(now, ranked, map_time)
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats
 

@@ -4,11 +4,13 @@ stood still (MotionWatch) and the longest stretch without new explored area (Pla
 seconds of ROS time, positions metres in the map frame."""
 import math
 from dataclasses import dataclass, field
-from typing import List, Optional, Tuple
+from typing import Callable, List, Optional, Tuple, Union
 
 import numpy as np
 
-from mbot_slam_navigation.nav.frontiers import Frontier, GivenUp
+from mbot_slam_navigation.nav.frontiers import CURRENT_RADIUS, Frontier, GivenUp
+
+ELIGIBLE, WAITING = 'eligible', 'waiting'  # ExploreState.screener's verdicts (or a GivenUp)
 
 
 @dataclass
@@ -93,10 +95,6 @@ class ExploreState:
         return [g for b in self.blacklist if b.cells is not None
                 and (b.reached or b.until > now or b.tries >= self.max_tries) for g in b.goals]
 
-    def _goals_sent_near(self, goal: Tuple[float, float]) -> int:
-        return sum(int(p[2]) for p in self.places
-                   if math.hypot(p[0] - goal[0], p[1] - goal[1]) < self.blacklist_radius)
-
     def _same_place(self, b: Blacklisted, f: Frontier, near_goal: Optional[bool] = None) -> bool:
         """`near_goal`: whether f's goal lies within blacklist_radius of one of b's goals, if the
         caller knows (screen works it out for all places at once)."""
@@ -113,13 +111,29 @@ class ExploreState:
 
     def screen(self, now: float, frontiers: List[Frontier],
                map_time: float = math.inf) -> Tuple[List[Frontier], int, List[GivenUp]]:
-        """(frontiers that may be sent now, how many wait, those given up for good) by the failures
-        recorded: a frontier that is the place of a failed goal (its goal near that goal, or most of
-        its cells near the failed frontier's cells, however it has grown or shrunk since) waits
-        blacklist_timeout, and is given up after max_tries failures. A frontier still there at a
-        goal reached is given up only on a map made after the robot got there (map_time [s], the
-        stamp of the map the frontiers come from); until then it waits, settle_time at most."""
+        """(frontiers that may be sent now, how many wait, those given up for good): screener's
+        judgement of each."""
+        judge = self.screener(now, map_time)
         eligible, waiting, given_up = [], 0, []
+        for f in frontiers:
+            verdict = judge(f)
+            if verdict is ELIGIBLE:
+                eligible.append(f)
+            elif verdict is WAITING:
+                waiting += 1
+            else:
+                given_up.append(verdict)
+        return eligible, waiting, given_up
+
+    def screener(self, now: float, map_time: float = math.inf) -> Callable[[Frontier], Union[str, GivenUp]]:
+        """A judge of frontiers by the failures recorded: ELIGIBLE (may be sent now), WAITING, or
+        given up for good (a GivenUp, with why). A frontier that is the place of a failed goal (its
+        goal near that goal, or most of its cells near the failed frontier's cells, however it has
+        grown or shrunk since) waits blacklist_timeout, and is given up after max_tries failures. A
+        frontier still there at a goal reached is given up only on a map made after the robot got
+        there (map_time [s], the stamp of the map the frontiers come from); until then it waits,
+        settle_time at most."""
+        places = np.array(self.places, float).reshape(-1, 3)  # [x, y, new goals sent there]
         failures = [b for b in self.blacklist if b.cells is not None]
         # Which places can be f's at all, for all places at once (a building's exploration records
         # hundreds): the cells' boxes within 0.3 m of each other, or a goal within blacklist_radius.
@@ -128,14 +142,15 @@ class ExploreState:
             lo, hi = np.array([bx[0] for bx in boxes]), np.array([bx[1] for bx in boxes])
             goals = np.array([g for b in failures for g in b.goals], float).reshape(-1, 2)
             owner = np.repeat(np.arange(len(failures)), [len(b.goals) for b in failures])
-        for f in frontiers:
-            sent = self._goals_sent_near(f.goal)
+
+        def judge(f: Frontier) -> Union[str, GivenUp]:
+            sent = int(np.sum(places[np.hypot(places[:, 0] - f.goal[0], places[:, 1] - f.goal[1])
+                                     < self.blacklist_radius, 2]))
             if sent >= self.max_goals_per_place:
                 # Chosen again and again and never explored (two frontiers pulling the robot to and
                 # fro): a bound on goals per place is what makes every exploration end.
                 x, y = f.cells.mean(axis=0)
-                given_up.append(GivenUp(float(x), float(y), f.size_m, 'sent %d times and never explored' % sent))
-                continue
+                return GivenUp(float(x), float(y), f.size_m, 'sent %d times and never explored' % sent)
             matches = []
             if failures:
                 flo, fhi = f.cells.min(axis=0), f.cells.max(axis=0)
@@ -151,13 +166,13 @@ class ExploreState:
             if exhausted:
                 x, y = f.cells.mean(axis=0)
                 b = exhausted[0]
-                given_up.append(GivenUp(float(x), float(y), f.size_m, b.why if b.reached else
-                                        '%d goals failed (last: %s)' % (b.tries, b.why)))
-            elif unsettled or any(b.until > now and not b.reached for b in matches):
-                waiting += 1
-            else:
-                eligible.append(f)
-        return eligible, waiting, given_up
+                return GivenUp(float(x), float(y), f.size_m, b.why if b.reached else
+                               '%d goals failed (last: %s)' % (b.tries, b.why))
+            if unsettled or any(b.until > now and not b.reached for b in matches):
+                return WAITING
+            return ELIGIBLE
+
+        return judge
 
     def choose(self, now: float, frontiers: List[Frontier], robot: Tuple[float, float]) -> Optional[Frontier]:
         """The frontier to head for (a goal to send), or None to keep the current goal; with no
@@ -174,7 +189,7 @@ class ExploreState:
             gx, gy = self.goal.goal
             near = [(float(np.min(np.hypot(f.cells[:, 0] - gx, f.cells[:, 1] - gy))), i) for i, f in enumerate(frontiers)]
             d, i = min(near)
-            current = [frontiers[i]] if d < 1.0 else []
+            current = [frontiers[i]] if d < CURRENT_RADIUS else []
             if not current:
                 # Its frontier is gone (mapped on the way, or below min_frontier_size now): the place
                 # counts as visited, so that a frontier flickering there does not pull the robot back.

@@ -11,9 +11,10 @@ shorter than `min_frontier_size` [m] (cells x resolution, as explore_lite measur
 The goal of a frontier is its cell nearest to the robot by path on the global costmap (cells below
 the inscribed cost, known), never its centroid, which may lie inside a wall.
 """
+import bisect
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -48,6 +49,7 @@ class Grid:
 
 
 GAIN_RADIUS = 1.0  # [m] around a frontier's cells: the unknown space it borders (Frontier.unknown_m2)
+CURRENT_RADIUS = 1.0  # [m] a frontier with a cell this near the goal being driven to is that goal's
 SHADOW_EDGE = 1.3  # [m] an enclosed unknown region with a connected piece of open rim this wide is floor
 
 
@@ -91,7 +93,7 @@ def unknown_space(m: Grid, occupied_min: int = SAVER_OCCUPIED, min_unknown_area:
     shadow against two walls has only 41-50% of its rim open (the kitchen's corner: 38% in cells,
     its edge 1.4-2.6 m; the home's table and bathroom object, seen round, 1.0-1.2 m).
     """
-    data = m.data.astype(np.int16)
+    data = m.data
     unknown = (data < 0).astype(np.uint8)
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
@@ -126,7 +128,7 @@ def _longest_piece(mask: np.ndarray) -> float:
 def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells: int = 1) -> List[np.ndarray]:
     """The frontiers of at least min_cells cells, largest first (a large map has thousands of
     one- and two-cell fragments: they are counted, not listed)."""
-    data = m.data.astype(np.int16)
+    data = m.data
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
@@ -147,11 +149,11 @@ def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells:
 def passable(costmap: Grid, m: Grid, occupied_min: int = SAVER_OCCUPIED) -> np.ndarray:
     """Costmap cells the robot's centre may cross: cost below inscribed, and known and not occupied
     in the map (the costmap may count unknown space as free)."""
-    cost = costmap.data.astype(np.int16)
+    cost = costmap.data
     ok = (cost >= 0) & (cost < COST_INSCRIBED)
     if (m.data.shape == cost.shape and m.resolution == costmap.resolution
             and np.allclose(m.origin, costmap.origin, atol=1e-6 * m.resolution)):
-        v = m.data.astype(np.int16)  # the usual case: the global costmap is laid on the map
+        v = m.data  # the usual case: the global costmap is laid on the map
         return ok & (v >= 0) & (v < occupied_min)
     rows, cols = np.indices(cost.shape)
     x, y = costmap.centre_of(rows, cols)
@@ -161,6 +163,34 @@ def passable(costmap: Grid, m: Grid, occupied_min: int = SAVER_OCCUPIED) -> np.n
     v = m.data[mr[inside], mc[inside]].astype(np.int16)
     known_open[inside] = (v >= 0) & (v < occupied_min)
     return ok & known_open
+
+
+def _crop(g: Grid, r0: int, c0: int, r1: int, c1: int) -> Grid:
+    return Grid(g.data[r0:r1, c0:c1], g.resolution,
+                (g.origin[0] + c0 * g.resolution, g.origin[1] + r0 * g.resolution))
+
+
+def _around_known(m: Grid, costmap: Grid, robot: Tuple[float, float], margin: int) -> Tuple[Grid, Grid]:
+    """(m, costmap) cut to the known cells of m and the robot's cell, grown by `margin` cells (and
+    by one more, so that every unknown cell beyond the cut is unknown space reaching the cut's edge,
+    as it reaches the map's edge beyond). A SLAM map is allocated larger than what is known (at the
+    start of a large building, many times larger): the search runs over the part that can hold a
+    frontier. The costmap is cut with the map when it is laid on it (the usual case), else kept."""
+    known = m.data >= 0
+    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
+    if not len(rows):
+        return m, costmap
+    rr, rc = m.cell_of(robot[0], robot[1])
+    r0, r1 = min(int(rows[0]), int(rr)) - margin - 1, max(int(rows[-1]), int(rr)) + margin + 2
+    c0, c1 = min(int(cols[0]), int(rc)) - margin - 1, max(int(cols[-1]), int(rc)) + margin + 2
+    h, w = m.data.shape
+    # at multiples of 4 cells: tour_order's blocks of 1, 2 or 4 cells stay those of the whole map
+    r0, c0, r1, c1 = max(r0 // 4 * 4, 0), max(c0 // 4 * 4, 0), min(r1, h), min(c1, w)
+    if (r0, c0, r1, c1) == (0, 0, h, w):
+        return m, costmap
+    same = (costmap.data.shape == m.data.shape and costmap.resolution == m.resolution
+            and np.allclose(m.origin, costmap.origin, atol=1e-6 * m.resolution))
+    return _crop(m, r0, c0, r1, c1), _crop(costmap, r0, c0, r1, c1) if same else costmap
 
 
 def _sees(cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, cells: np.ndarray) -> np.ndarray:
@@ -185,7 +215,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                    stats: Optional[dict] = None, avoid_goals: Sequence[Tuple[float, float]] = (),
                    unreachable: Optional[List[GivenUp]] = None,
                    keep_goal: Optional[Tuple[float, float]] = None,
-                   min_unknown_beside: float = 0.0, gain_size_max: float = 0.0) -> List[Frontier]:
+                   min_unknown_beside: float = 0.0, gain_size_max: float = 0.0, enough: int = 0,
+                   eligible: Optional[Callable[[Frontier], bool]] = None) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
@@ -209,24 +240,31 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     20 m of path, and the lobby behind the robot was left for last: 13-19 m back across the floor at
     the end, plateaus of 67 and 113 s.
     """
+    g_reach = int(math.ceil(GAIN_RADIUS / m.resolution))
+    k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1  # the window of cells within goal_reach
+    m, costmap = _around_known(m, costmap, robot, g_reach + k + 2)
+    if stats is not None:
+        stats['costmap'] = costmap  # the part of it searched (stats['passable']'s grid)
     rr, rc = costmap.cell_of(robot[0], robot[1])
     if not costmap.inside(rr, rc):
         if stats is not None:
             stats['robot_outside'] = True  # the costmap has not grown to the robot yet
         return []
     open_cells = passable(costmap, m, occupied_min)
-    cost = costmap.data.astype(np.int16)
+    cost = costmap.data
     # Within escape_radius of the robot, any cell short of lethal is passable: a robot that stands
     # in the inscribed zone (an obstacle appeared beside it) can still back out, as move_base does.
-    rows, cols = np.ogrid[:cost.shape[0], :cost.shape[1]]
-    around = (rows - rr) ** 2 + (cols - rc) ** 2 <= (escape_radius / costmap.resolution) ** 2
-    open_cells = open_cells | (around & (cost >= 0) & (cost < 100))
-    dist = _core._path_lengths(open_cells.astype(np.uint8), int(rc), int(rr))
+    e = int(math.ceil(escape_radius / costmap.resolution))
+    er0, ec0 = max(int(rr) - e, 0), max(int(rc) - e, 0)
+    rows, cols = np.ogrid[er0:int(rr) + e + 1, ec0:int(rc) + e + 1]
+    near = cost[er0:int(rr) + e + 1, ec0:int(rc) + e + 1]
+    around = ((rows - rr) ** 2 + (cols - rc) ** 2 <= (escape_radius / costmap.resolution) ** 2) & (near >= 0) & (near < 100)
+    open_cells[er0:er0 + around.shape[0], ec0:ec0 + around.shape[1]] |= around
+    dist = _core._path_lengths(open_cells.view(np.uint8), int(rc), int(rr))
     if stats is not None:
         stats['reachable_m2'] = float(np.count_nonzero(dist >= 0)) * costmap.resolution ** 2
         stats['passable'] = open_cells  # for tour_order
-    reach_ok = (dist >= 0) & open_cells & (cost < goal_cost_max)
-    goal_ok = reach_ok
+    blocked = None
     avoid_goals = np.asarray(avoid_goals, float).reshape(-1, 2)
     if len(avoid_goals):
         blocked = np.zeros(cost.shape, np.uint8)
@@ -234,18 +272,23 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
         for gx, gy in avoid_goals:
             br, bc = costmap.cell_of(gx, gy)
             cv2.circle(blocked, (int(bc), int(br)), r, 1, -1)
-        goal_ok = reach_ok & (blocked == 0)
-    k = 2 * int(math.ceil(goal_reach / costmap.resolution)) + 1  # the window of cells within goal_reach
+
+    def reach_and_goal_ok(r0: int, c0: int, r1: int, c1: int) -> Tuple[np.ndarray, np.ndarray]:
+        """In the window [r0, r1) x [c0, c1): the cells the robot can reach clear of the inflated
+        zone (cost below goal_cost_max), and those of them that may be goals (not near avoid_goals)."""
+        reach_ok = (dist[r0:r1, c0:c1] >= 0) & open_cells[r0:r1, c0:c1] & (cost[r0:r1, c0:c1] < goal_cost_max)
+        return reach_ok, reach_ok if blocked is None else reach_ok & (blocked[r0:r1, c0:c1] == 0)
     avoid = np.asarray(avoid, float).reshape(-1, 2)
     kr, kc = costmap.cell_of(*keep_goal) if keep_goal is not None else (-1, -1)
     unknown = unknown_space(m, occupied_min, min_unknown_area)
-    g_reach = int(math.ceil(GAIN_RADIUS / m.resolution))
     # beyond the grid's edge is unknown too (the SLAM map grows as the robot sees more)
     unknown_beyond = cv2.copyMakeBorder(unknown, g_reach, g_reach, g_reach, g_reach, cv2.BORDER_CONSTANT, value=1)
-    out = []
-    for g in _frontier_groups(m, unknown, occupied_min, max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9)))):
-        if len(g) * m.resolution < min_frontier_size:
-            break  # the groups come largest first: the rest are smaller still
+    groups = [g for g in _frontier_groups(m, unknown, occupied_min,
+                                          max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9))))
+              if len(g) * m.resolution >= min_frontier_size]
+
+    def evaluate(g: np.ndarray) -> Optional[Frontier]:
+        """The frontier of group g ((N, 2) rows, cols), or None (appended to `unreachable`)."""
         x, y = m.centre_of(g[:, 0], g[:, 1])
         if len(avoid):
             keep = np.min(np.hypot(x[:, None] - avoid[None, :, 0], y[:, None] - avoid[None, :, 1]), axis=1) >= avoid_radius
@@ -254,7 +297,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                     unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), len(x) * m.resolution,
                                                'too little of it (%.2f m) lies farther than %.1f m from places '
                                                'visited or given up' % (keep.sum() * m.resolution, avoid_radius)))
-                continue
+                return None
             x, y, g = x[keep], y[keep], g[keep]
         # the unknown space it borders, within GAIN_RADIUS of its cells (in a window around it;
         # unknown_beyond's cell (r + g_reach, c + g_reach) is the map's (r, c))
@@ -272,7 +315,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                 unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
                                            'only %.2f m^2 unknown within %.1f m of it (min_unknown_beside %.2f m^2)'
                                            % (unknown_m2, GAIN_RADIUS, min_unknown_beside)))
-            continue
+            return None
         cr, cc = costmap.cell_of(x, y)
         inside = costmap.inside(cr, cc)
         # the cells within goal_reach of the frontier, in a window around it (not the whole grid)
@@ -284,8 +327,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
             far = np.ones(candidates.shape, np.uint8)  # 0 on the frontier's cells
             far[cr[inside] - r0, cc[inside] - c0] = 0
             near = cv2.distanceTransform(far, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) <= half
-            reachable = near & reach_ok[r0:r1, c0:c1]
-            candidates = reachable & goal_ok[r0:r1, c0:c1]
+            reach_ok, goal_ok = reach_and_goal_ok(r0, c0, r1, c1)
+            reachable, candidates = near & reach_ok, near & goal_ok
         if not candidates.any():
             if unreachable is not None:
                 why = ('its only goals lie within %.1f m of goals that failed or where the robot stood with it '
@@ -293,7 +336,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                        'unreachable: no cell within %.1f m of it that the robot can reach clear of obstacles on the '
                        'global costmap' % goal_reach)
                 unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size, why))
-            continue
+            return None
         d = np.where(candidates, dist[r0:r1, c0:c1], np.inf)
         fcells = np.column_stack([cr[inside], cc[inside]])
         # an obstacle the costmap has on a frontier cell (seen since the map was made) blocks no view
@@ -326,10 +369,45 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                     unreachable.append(GivenUp(float(np.mean(x)), float(np.mean(y)), size,
                                                'unreachable: every cell within %.1f m of it that the robot can '
                                                'reach lies across a wall from it' % goal_reach))
-                continue
+                return None
         gx, gy = costmap.centre_of(gr, gc)
         path_m = float(d[gr - r0, gc - c0]) * costmap.resolution
         gain = min(size, gain_size_max) if gain_size_max > 0 else size
-        out.append(Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
-                            potential_scale * path_m - gain_scale * gain, unknown_m2))
-    return sorted(out, key=lambda f: f.cost)
+        return Frontier(np.column_stack([x, y]), size, (float(gx), float(gy)), path_m,
+                        potential_scale * path_m - gain_scale * gain, unknown_m2)
+
+    out = []
+    # In the order of a lower bound of their cost (the straight line to their nearest cell, less
+    # goal_reach, and their whole size), the frontiers near keep_goal first (ExploreState.choose
+    # looks for the one being explored there): with `enough`, the ranking stops when that many
+    # frontiers taken by `eligible` are ranked and no frontier left can cost less than the
+    # enough-th of them. Ranking a frontier takes 0.3-1 ms; a large building has a hundred, of
+    # which the explorer can use the best tour_frontiers.
+    lower = np.zeros(len(groups))
+    first = np.zeros(len(groups), bool)
+    if potential_scale < 0 or gain_scale < 0:
+        enough = 0  # no lower bound then
+    if enough > 0:
+        for i, g in enumerate(groups):
+            x, y = m.centre_of(g[:, 0], g[:, 1])
+            gain = len(g) * m.resolution
+            gain = min(gain, gain_size_max) if gain_size_max > 0 else gain
+            lower[i] = potential_scale * max(0.0, float(np.min(np.hypot(x - robot[0], y - robot[1]))) - goal_reach) \
+                - gain_scale * gain
+            if keep_goal is not None:
+                first[i] = np.min(np.hypot(x - keep_goal[0], y - keep_goal[1])) < CURRENT_RADIUS
+    order = sorted(range(len(groups)), key=lambda i: (not first[i], lower[i]))
+    taken: List[float] = []  # costs of the eligible frontiers ranked, ascending
+    unranked = []
+    for n, i in enumerate(order):
+        if enough > 0 and not first[i] and len(taken) >= enough and lower[i] > taken[enough - 1]:
+            unranked = [groups[j] for j in order[n:]]
+            break
+        f = evaluate(groups[i])
+        if f is not None:
+            out.append((f.cost, i, f))  # equal costs: the larger first, however they were ranked
+            if eligible is None or eligible(f):
+                bisect.insort(taken, f.cost)
+    if stats is not None:
+        stats['unranked'] = [np.column_stack(m.centre_of(g[:, 0], g[:, 1])) for g in unranked]
+    return [f for _, _, f in sorted(out, key=lambda e: e[:2])]
