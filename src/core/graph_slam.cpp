@@ -102,6 +102,8 @@ Eigen::Matrix3d GraphSlam::edgeInformation(double scale) const {
 }
 
 bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
+  if (resume_pending_) return resumeWith(odom, scan, time_s);
+  if (localization_) return localize(odom, scan);
   bool first;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -331,7 +333,25 @@ void GraphSlam::rebuildLocalMapLocked() {
   const double reach = matchReach();
   local_seen_.clear();
   bool all_scans = true;
-  for (int k = std::max(0, n - params_.local_map_nodes); k < n; ++k) {
+  std::vector<int> members;
+  for (int k = std::max(session_start_, n - params_.local_map_nodes); k < n; ++k) members.push_back(k);
+  if (session_start_ > 0 && static_cast<int>(members.size()) < params_.local_map_nodes) {
+    // A continued session: the saved nodes nearest the robot, with their scans, make up the rest,
+    // so that the new scans are tracked against the old map where the robot drives through it.
+    const Eigen::Vector2d at = nodes_.back().pose.head<2>();
+    std::vector<std::pair<double, int>> saved;
+    for (int k = 0; k < session_start_; ++k) {
+      const double d = (nodes_[k].pose.head<2>() - at).norm();
+      if (nodes_[k].scan && d <= reach) saved.emplace_back(d, k);
+    }
+    const std::size_t wanted = params_.local_map_nodes - members.size();
+    if (saved.size() > wanted) {
+      std::nth_element(saved.begin(), saved.begin() + wanted, saved.end());
+      saved.resize(wanted);
+    }
+    for (const auto& [d, k] : saved) members.push_back(k);
+  }
+  for (int k : members) {
     // Walls as surfaces, not as the beams' hits (surfacePoints): hits thin out with range, so a
     // scan tracked in a map of hits alone scores higher moved back towards where the nodes saw from.
     if (nodes_[k].scan) {
@@ -501,7 +521,7 @@ void GraphSlam::buildSubmap(int first, int last) {
 }
 
 bool GraphSlam::searchClosures(int n) {
-  if ((n + 1) % params_.submap_nodes == 0) buildSubmap(n + 1 - params_.submap_nodes, n);
+  if (completesSubmap(n)) buildSubmap(n + 1 - params_.submap_nodes, n);
 
   struct Candidate {
     double distance;
@@ -523,7 +543,7 @@ bool GraphSlam::searchClosures(int n) {
     points = nodes_[n].points;
     redundant = nodes_[n].redundant;
     // The submap ending at n is built and n's points are held here: nodes up to n may be trimmed.
-    if ((n + 1) % params_.submap_nodes == 0) submapped_upto_ = n;
+    if (completesSubmap(n)) submapped_upto_ = n;
     travelled = nodes_[n].travelled_m;
     radius = std::min(params_.loop_search_max_radius,
                       params_.loop_search_radius + params_.loop_search_growth * (travelled - last_closure_travelled_));
@@ -533,10 +553,12 @@ bool GraphSlam::searchClosures(int n) {
     const int recent = n - params_.local_map_nodes - params_.submap_nodes;
     const int behind = params_.loop_recent_submap ? n - params_.local_map_nodes : recent;
     for (const Submap& s : submaps_) {
-      if (s.last >= behind) continue;
+      // A submap of a saved session is a loop for the nodes after it, whatever their indices.
+      const bool saved = s.last < session_start_ && n >= session_start_;
+      if (!saved && s.last >= behind) continue;
       double nearest = std::numeric_limits<double>::infinity();
       for (int k = s.first; k <= s.last; ++k) nearest = std::min(nearest, (nodes_[k].pose.head<2>() - pose.head<2>()).norm());
-      if (s.last >= recent) {
+      if (!saved && s.last >= recent) {
         if (nearest <= params_.loop_search_reach && s.first > recent_candidate.anchor_index) {
           recent_candidate = {nearest, nodes_[s.first].pose, s.first, s.last, s.grid, s.seen, true};
         }

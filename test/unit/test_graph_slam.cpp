@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <random>
+#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -795,4 +796,149 @@ TEST(GraphSlam, EachNodeIsMatchedAgainstTheSubmapJustBehindItsLocalMap) {
   EXPECT_GE(on.closures_recent, 5) << "nodes 30-39 all lie within reach of nodes 0-9";
   EXPECT_NEAR(on.search_radius_m, expected_radius, 0.02) << "a closure to the submap behind is not a loop";
   EXPECT_GT(on.search_radius_m, d.loop_search_radius + 0.05) << "else the check above shows nothing";
+}
+
+// Sessions (graph_session.cpp): save, load, continue, localize; bad files.
+namespace {
+
+std::string saved(GraphSlam& slam) {
+  std::ostringstream out;
+  slam.saveSession(out);
+  return out.str();
+}
+
+// The second lap's odometry as a robot restarted at the lap's start would give it: from zero.
+Eigen::Vector3d restartedOdom(const Drive& d, std::size_t i, std::size_t from) {
+  return relativePose(d.odom[from], d.odom[i]);
+}
+
+}  // namespace
+
+TEST(GraphSession, ASavedSessionLoadsWithTheSameGraphAndMap) {
+  const World2D w = squareCorridor();
+  const Drive d = laps(1);
+  GraphSlam slam(corridorParams());
+  endError(slam, d, w);
+  const std::string bytes = saved(slam);
+  auto loaded = GraphSlam::loadSession(bytes, corridorParams());
+  ASSERT_TRUE(loaded);
+  const auto a = slam.trajectory(), b = loaded->trajectory();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_LT((a[i].pose - b[i].pose).norm(), 1e-12);
+    EXPECT_DOUBLE_EQ(a[i].time_s, b[i].time_s);
+  }
+  EXPECT_EQ(slam.edges().size(), loaded->edges().size());
+  EXPECT_EQ(loaded->stats().submaps, slam.stats().submaps);
+  const OccupancyImage m1 = slam.occupancy(0.25), m2 = loaded->occupancy(0.25);
+  ASSERT_EQ(m1.data.size(), m2.data.size());
+  EXPECT_EQ(m1.data, m2.data) << "the same scans at the same poses";
+  EXPECT_TRUE(loaded->resuming());
+  EXPECT_LT((loaded->firstPose() - d.truth.front()).norm(), 0.05);
+  // a second save of the loaded session is the same file
+  EXPECT_EQ(saved(*loaded), bytes);
+}
+
+TEST(GraphSession, AContinuedSessionLandsOnTheOldMapAndClosesOnIt) {
+  const World2D w = squareCorridor();
+  const Drive d = twoLaps();
+  const std::size_t half = d.truth.size() / 2;  // the end of the first lap, back at (-5, -5)
+  GraphSlam first(corridorParams());
+  endError(first, d, w, 0, half);
+  const std::string bytes = saved(first);
+
+  for (bool at_dock : {true, false}) {
+    auto slam = GraphSlam::loadSession(bytes, corridorParams());
+    // Continued where the first lap began (the dock), 0.2 m and 0.1 rad off; or found by global matching.
+    if (at_dock) {
+      slam->resume(slam->firstPose() + Eigen::Vector3d(0.2, -0.1, 0.1), false);
+    } else {
+      slam->resume(std::nullopt, false);
+    }
+    // Given a pose, the first scan joins; found by matching, the first scan whose view is not
+    // repeated elsewhere (the corridor's corners look alike turned by 90 degrees), within 5 m.
+    std::mt19937 rng(11);
+    std::size_t joined = 0;
+    for (std::size_t i = half; i < d.truth.size(); ++i) {
+      slam->processScan(restartedOdom(d, i, half), scanAt(w, d.truth[i], rng), 0.1 * i);
+      if (slam->resuming()) {
+        ASSERT_FALSE(at_dock) << slam->resumeFailure();
+        ASSERT_LT(i - half, 50u) << slam->resumeFailure();
+        EXPECT_NE(slam->resumeFailure().find("equally well"), std::string::npos) << slam->resumeFailure();
+        continue;
+      }
+      if (joined == 0) joined = i;
+      if (i == joined + 5) {
+        EXPECT_LT((slam->currentPose().head<2>() - d.truth[i].head<2>()).norm(), 0.1) << "at_dock " << at_dock;
+      }
+    }
+    EXPECT_EQ(joined == half, at_dock);
+    slam->flush();
+    EXPECT_LT((slam->currentPose().head<2>() - d.truth.back().head<2>()).norm(), 0.1) << "at_dock " << at_dock;
+    EXPECT_GT(slam->stats().loop_closures, first.stats().loop_closures) << "the new lap closes on the saved one";
+    EXPECT_GT(slam->trajectory().size(), first.trajectory().size());
+  }
+}
+
+TEST(GraphSession, LocalizationTracksOnTheSavedMapWithoutGrowingIt) {
+  const World2D w = squareCorridor();
+  const Drive d = twoLaps();
+  const std::size_t half = d.truth.size() / 2;
+  GraphSlam first(corridorParams());
+  endError(first, d, w, 0, half);
+  auto slam = GraphSlam::loadSession(saved(first), corridorParams());
+  const std::size_t nodes = slam->trajectory().size();
+  slam->resume(slam->firstPose(), true);
+  std::mt19937 rng(13);
+  double worst = 0.0, sum = 0.0;
+  for (std::size_t i = half; i < d.truth.size(); ++i) {
+    EXPECT_FALSE(slam->processScan(restartedOdom(d, i, half), scanAt(w, d.truth[i], rng), 0.1 * i));
+    const double e = (slam->currentPose().head<2>() - d.truth[i].head<2>()).norm();
+    worst = std::max(worst, e);
+    sum += e;
+  }
+  EXPECT_TRUE(slam->localizing());
+  EXPECT_LT(sum / (d.truth.size() - half), 0.05);
+  EXPECT_LT(worst, 0.15);
+  EXPECT_EQ(slam->trajectory().size(), nodes) << "localization adds no node";
+}
+
+TEST(GraphSession, AStartPoseFarFromTheTruthIsRefusedWithTheReason) {
+  const World2D w = squareCorridor();
+  const Drive d = laps(1);
+  GraphSlam first(corridorParams());
+  endError(first, d, w);
+  auto slam = GraphSlam::loadSession(saved(first), corridorParams());
+  slam->resume(Eigen::Vector3d(5.0, 5.0, 0.0), false);  // the opposite corner
+  std::mt19937 rng(3);
+  EXPECT_FALSE(slam->processScan(Eigen::Vector3d::Zero(), scanAt(w, d.truth.front(), rng), 0.0));
+  EXPECT_TRUE(slam->resuming());
+  EXPECT_NE(slam->resumeFailure().find("does not match the saved map within"), std::string::npos)
+      << slam->resumeFailure();
+}
+
+TEST(GraphSession, BadFilesAreRefusedWithWhatIsWrong) {
+  const World2D w = squareCorridor();
+  GraphSlam slam(corridorParams());
+  endError(slam, laps(1), w, 0, 200);
+  const std::string good = saved(slam);
+  auto refused = [](const std::string& bytes) {
+    try {
+      GraphSlam::loadSession(bytes, corridorParams());
+    } catch (const SessionError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refused("").find("empty"), std::string::npos);
+  EXPECT_NE(refused(good.substr(0, good.size() / 2)).find("truncated"), std::string::npos);
+  std::string damaged = good;
+  damaged[good.size() / 2] ^= 0x5a;
+  EXPECT_NE(refused(damaged).find("damaged"), std::string::npos);
+  std::string version = good;
+  version[17] = 9;  // the version's first byte, after the 17-byte header
+  EXPECT_NE(refused(version).find("format version 9"), std::string::npos) << refused(version);
+  EXPECT_NE(refused("22 serialization::archive 17 0 0 ...").find("Boost archive"), std::string::npos);
+  EXPECT_NE(refused("P5\n10 10\n255\n").find("not a session"), std::string::npos);
+  EXPECT_EQ(refused(good), "accepted");
 }

@@ -62,6 +62,9 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -242,6 +245,12 @@ struct GraphSlamStats {
   std::size_t submap_bytes = 0;     ///< the kept submaps' grids with the pooled levels cached
 };
 
+/// A saved session that cannot be read: what is wrong with it (the caller names the file).
+class SessionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class GraphSlam : public SlamBackend {
  public:
   explicit GraphSlam(const GraphSlamParams& params);
@@ -271,6 +280,39 @@ class GraphSlam : public SlamBackend {
   /// The graph's edges (chain and closures), for drawing and tests.
   std::vector<PoseGraphEdge> edges() const;
   const GraphSlamParams& params() const { return params_; }
+
+  // Sessions (slam_toolbox's serialize_map / deserialize_map). A session file holds a format
+  // version, the backend's name, the laser's pose and ranges the scans were taken with, every
+  // node (pose, odometry, time, distance travelled, its scan if kept, how it was merged), the
+  // edges and the submaps' node ranges; its last 8 bytes are a checksum of the rest, so a
+  // truncated or damaged file is told from a good one. Binary, little-endian.
+
+  /// Writes the session to `out` (waits for the closure search of the nodes so far: flush()).
+  void saveSession(std::ostream& out);
+  /// A GraphSlam holding the session in `bytes` (a whole file), with `params` for what comes next;
+  /// the laser's pose and ranges are the session's (`notes` gets a sentence for each that differs
+  /// from `params`). The submaps are rebuilt from the nodes' scans. The next scan joins it as
+  /// resume() says. Throws SessionError.
+  static std::unique_ptr<GraphSlam> loadSession(const std::string& bytes, const GraphSlamParams& params,
+                                               std::string* notes = nullptr);
+  /// How the next scans join a loaded session: the robot's base near `pose` (the session's map
+  /// frame; searched within resume_window_m and resume_angle_rad of it), or, without a pose,
+  /// anywhere on the session's map (the whole map searched, every heading: global matching). With
+  /// `localization`, scans are then tracked against the saved nodes near the robot and the graph
+  /// does not grow (slam_toolbox's localization mode); without, new nodes extend the graph from
+  /// there, their loop closures reaching the saved part. Until a scan matches, processScan()
+  /// returns false and resumeFailure() says why.
+  void resume(const std::optional<Eigen::Vector3d>& pose, bool localization);
+  /// Why the last scan did not join the session (empty once it has, or before any tried).
+  std::string resumeFailure() const;
+  /// Whether scans still wait to join a loaded session.
+  bool resuming() const;
+  bool localizing() const;
+  /// The session's first node (the dock: map_start_at_dock); the origin for an empty graph.
+  Eigen::Vector3d firstPose() const;
+  static constexpr double kResumeWindow = 0.5;   ///< [m] +- x, y around a given start pose
+  static constexpr double kResumeAngle = 0.35;   ///< [rad] +- yaw around it
+  static constexpr uint32_t kSessionVersion = 1;
 
  private:
   struct Node {
@@ -302,6 +344,15 @@ class GraphSlam : public SlamBackend {
   };
 
   Eigen::Vector3d matchLocally(const Eigen::Vector3d& predicted, const std::vector<Eigen::Vector2d>& points);
+  /// processScan while resuming: finds the scan on the session's map and joins it (graph_session.cpp).
+  bool resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s);
+  /// processScan in localization mode after the robot was found: tracks the scan only.
+  bool localize(const Eigen::Vector3d& odom, const LaserScan& scan);
+  /// A local map of the saved nodes nearest `pose` (those with their scans, within the match
+  /// reach), in the map frame; null if none (mutex_ held for the node list).
+  std::unique_ptr<LikelihoodGrid> sessionMapNearLocked(const Eigen::Vector3d& pose, Visibility* seen) const;
+  /// Whether node n completes a submap (submaps count from the session's start: session_start_).
+  bool completesSubmap(int n) const { return n >= session_start_ && (n + 1 - session_start_) % params_.submap_nodes == 0; }
   void rebuildLocalMapLocked();  // mutex_ held
   void backgroundLoop();
   /// Closure search for one node and the submap that it completes; returns true if it added an
@@ -378,6 +429,15 @@ class GraphSlam : public SlamBackend {
   // The same over the directions each match pinned (the prior's weight), per direction times 2.
   double pinned_innovation2_ = 0.0;
   long pinned_innovations_ = 0;
+
+  // Sessions: nodes before session_start_ were loaded from a file (rebuildLocalMapLocked tops the
+  // local map up with those near the robot); resume_ says how the next scan joins them.
+  int session_start_ = 0;
+  bool resume_pending_ = false, localization_ = false;
+  std::optional<Eigen::Vector3d> resume_pose_;
+  std::string resume_failure_;
+  std::unique_ptr<LikelihoodGrid> session_grid_;  // the whole saved map, for global matching
+  Eigen::Vector3d localized_at_ = Eigen::Vector3d::Zero();  // where the localization's local map was built
 
   double search_window_ = 0.0;  // [m] the tracking window for the next scan (local_search_sigmas)
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0, travelled_ = 0.0;
