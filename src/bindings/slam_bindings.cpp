@@ -1,6 +1,9 @@
 // Bindings of the SLAM backends and their parameters (offline tools and tests; the node is roscpp).
 #include "bindings.h"
 
+#include <array>
+#include <optional>
+#include <string>
 #include <tuple>
 
 #include "mbot_slam_navigation/core/graph_slam.h"
@@ -233,7 +236,44 @@ void bindSlam(py::module& m) {
                out.emplace_back(e.from, e.to, e.measurement.x(), e.measurement.y(), e.measurement.z(), e.robust);
              }
              return out;
-           });
+           })
+      // Sessions (graph_slam.h): save to / load from <path> (the .posegraph file itself).
+      .def(
+          "save_session",
+          [](GraphSlam& s, const std::string& path) {
+            py::gil_scoped_release release;
+            return mbot::core::saveSessionFile(s, path);
+          },
+          py::arg("path"))
+      .def_static(
+          "load_session",
+          [](const std::string& path, const GraphSlamParams& params) {
+            std::string notes;
+            std::unique_ptr<GraphSlam> slam;
+            try {
+              slam = GraphSlam::loadSession(mbot::core::readSessionFile(path), params, &notes);
+            } catch (const mbot::core::SessionError& e) {
+              throw mbot::core::SessionError("cannot load the session " + path + ": " + e.what());
+            }
+            return std::make_pair(std::move(slam), notes);
+          },
+          py::arg("path"), py::arg("params"))
+      .def(
+          "resume",
+          [](GraphSlam& s, std::optional<std::array<double, 3>> pose, bool localization) {
+            std::optional<Eigen::Vector3d> p;
+            if (pose) p = Eigen::Vector3d((*pose)[0], (*pose)[1], (*pose)[2]);
+            s.resume(p, localization);
+          },
+          py::arg("pose") = py::none(), py::arg("localization") = false)
+      .def("resuming", &GraphSlam::resuming)
+      .def("resume_failure", &GraphSlam::resumeFailure)
+      .def("first_pose", [](const GraphSlam& s) {
+        const Eigen::Vector3d p = s.firstPose();
+        return std::make_tuple(p.x(), p.y(), p.z());
+      });
+  py::register_exception<mbot::core::SessionError>(m, "SessionError", PyExc_ValueError);
+  m.def("session_path", &mbot::core::sessionPath, py::arg("filename"));
 }
 
 }  // namespace bindings

@@ -1,9 +1,16 @@
 // GraphSlam's sessions: saving the graph, loading it, and joining it with new scans (graph_slam.h).
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <sstream>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/pose2d.h"
@@ -136,6 +143,14 @@ void GraphSlam::saveSession(std::ostream& out) {
       w.put<int32_t>(s.first);
       w.put<int32_t>(s.last);
     }
+    // Every tracked scan's pose, if kept (keep_scan_poses: offline runs), so that a continued run
+    // can give the whole trajectory scan by scan.
+    w.put<uint64_t>(scans_.size());
+    for (const TrackedScan& t : scans_) {
+      w.put<double>(t.time_s);
+      w.put<int32_t>(t.node);
+      w.putPose(t.offset);
+    }
   }
   w.put<uint64_t>(checksum(w.bytes().data(), w.bytes().size()));
   out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
@@ -244,6 +259,15 @@ std::unique_ptr<GraphSlam> GraphSlam::loadSession(const std::string& bytes, cons
     const int first = r.get<int32_t>("submap"), last = r.get<int32_t>("submap");
     if (first < 0 || last < first || last >= count) throw SessionError("a submap holds nodes the session does not");
     submaps.emplace_back(first, last);
+  }
+  const uint64_t n_scans = r.count("tracked scans", 100 * kMaxNodes);
+  for (uint64_t i = 0; i < n_scans; ++i) {
+    TrackedScan t;
+    t.time_s = r.get<double>("tracked scan");
+    t.node = r.get<int32_t>("tracked scan");
+    if (t.node < 0 || t.node >= count) throw SessionError("a tracked scan refers to a node the session does not hold");
+    t.offset = r.getPose("tracked scan offset");
+    if (p.keep_scan_poses) g.scans_.push_back(t);
   }
   if (r.at() != end) throw SessionError("it holds " + std::to_string(end - r.at()) + " bytes more than its graph");
   if (count == 0) throw SessionError("it holds no nodes");
@@ -421,6 +445,7 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
     local_anchor_ = nodes_.back().pose;  // currentPose(): the last node composed with the track since it
     track_pose_ = found;
     localized_at_ = found;
+    if (params_.keep_scan_poses) scans_.push_back({time_s, session_start_ - 1, relativePose(local_anchor_, found)});
     return false;
   }
   // The first node of the new part, joined to the nearest saved node by the match.
@@ -438,6 +463,7 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
   edges_.push_back({nearest, index, relativePose(nodes_[nearest].pose, found), edgeInformation(1.0), false});
   auto shared_points = std::make_shared<const std::vector<Eigen::Vector2d>>(points);
   nodes_.push_back({found, odom, time_s, travelled_, std::make_shared<const LaserScan>(scan), shared_points, false});
+  if (params_.keep_scan_poses) scans_.push_back({time_s, index, Eigen::Vector3d::Zero()});
   if (params_.closures) {
     pending_.push_back(index);
   } else {
@@ -448,7 +474,7 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
   return true;
 }
 
-bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan) {
+bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
   Eigen::Vector3d predicted;
   bool rebuild;
   {
@@ -471,7 +497,64 @@ bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_odom_ = track_odom_ = odom;
   track_pose_ = tracked;
+  if (params_.keep_scan_poses) {
+    scans_.push_back({time_s, session_start_ - 1, relativePose(local_anchor_, tracked)});
+  }
   return false;
+}
+
+std::string sessionPath(const std::string& filename) {
+  std::string path = filename;
+  if (!path.empty() && path[0] == '~') {
+    const char* home = std::getenv("HOME");
+    path = std::string(home ? home : "") + path.substr(1);
+  }
+  const std::string ext = ".posegraph";
+  if (path.size() < ext.size() || path.compare(path.size() - ext.size(), ext.size(), ext) != 0) path += ext;
+  return path;
+}
+
+std::size_t saveSessionFile(GraphSlam& slam, const std::string& path) {
+  std::ostringstream out;
+  slam.saveSession(out);
+  const std::string bytes = out.str();
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + tmp + ": " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw std::runtime_error("cannot write " + tmp + ": " + why);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot write " + tmp + ": " + why);
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot replace " + path + ": " + why);
+  }
+  return bytes.size();
+}
+
+std::string readSessionFile(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) throw SessionError("no such file");
+  if (S_ISDIR(st.st_mode)) throw SessionError("it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SessionError(std::string("it cannot be read: ") + std::strerror(errno));
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
 }
 
 }  // namespace core

@@ -103,7 +103,7 @@ Eigen::Matrix3d GraphSlam::edgeInformation(double scale) const {
 
 bool GraphSlam::processScan(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
   if (resume_pending_) return resumeWith(odom, scan, time_s);
-  if (localization_) return localize(odom, scan);
+  if (localization_) return localize(odom, scan, time_s);
   bool first;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -27,6 +27,41 @@ SlamConfig readSlamConfig(const ParamValue& values, const std::string& ns, const
                      c.backend + "'");
   }
 
+  c.session_file = r.string("session_file", c.session_file,
+                            "start from this saved session (path without extension: <path>.posegraph; ~serialize_map "
+                            "writes one); '' starts a new map. Graph backend");
+  const ParamValue start = r.raw("map_start_pose", ParamValue::ofList(),
+                                 "[m, m, rad] [x, y, yaw] of the robot's base in the session's map; [] : "
+                                 "map_start_at_dock, or found by matching the first scans against the whole map",
+                                 "list");
+  if (start.type != ParamValue::Type::kList ||
+      (!start.items.empty() && (start.items.size() != 3 || !start.items[0].isNumber() || !start.items[1].isNumber() ||
+                                !start.items[2].isNumber()))) {
+    throw ParamError("parameter " + r.where("map_start_pose") + " must be [x, y, yaw] (metres, radians) or [], got " +
+                     start.repr());
+  }
+  if (!start.items.empty()) {
+    c.map_start_pose = Eigen::Vector3d(start.items[0].number(), start.items[1].number(), start.items[2].number());
+  }
+  c.map_start_at_dock = r.boolean("map_start_at_dock", c.map_start_at_dock,
+                                  "the robot stands where the session began (its first node)");
+  c.mode = r.string("mode", c.mode, "mapping (the graph grows) or localization (on session_file: tracks the robot on "
+                                    "the saved map, the graph does not grow)");
+  if (c.mode != "mapping" && c.mode != "localization") {
+    throw ParamError("parameter " + r.where("mode") + " must be 'mapping' or 'localization', got '" + c.mode + "'");
+  }
+  if (c.mode == "localization" && c.session_file.empty()) {
+    throw ParamError("parameter " + r.where("mode") + " is 'localization', which needs a saved map: set " +
+                     r.where("session_file"));
+  }
+  c.save_session_on_exit = r.string("save_session_on_exit", c.save_session_on_exit,
+                                    "write the session to this path (without extension) when the node shuts down; '' : "
+                                    "not. Graph backend");
+  if (c.backend != "graph" && (!c.session_file.empty() || !c.save_session_on_exit.empty())) {
+    throw ParamError("sessions (" + r.where(c.session_file.empty() ? "save_session_on_exit" : "session_file") +
+                     ") are the graph backend's; " + r.where("backend") + " is '" + c.backend + "'");
+  }
+
   // gmapping's: the matcher and updates both backends share.
   RbpfParams& p = c.rbpf;
   ScanMatcherParams& m = p.matcher;

@@ -24,12 +24,15 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <thread>
 
 #include <boost/make_shared.hpp>
 
 #include <malloc.h>
 #include <pthread.h>
+#include <unistd.h>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/GetMap.h>
@@ -47,6 +50,8 @@
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "mbot_slam_navigation/core/slam_config.h"
+#include "mbot_slam_navigation/DeserializePoseGraph.h"
+#include "mbot_slam_navigation/SerializePoseGraph.h"
 #include "ros_conversions.h"
 #include "sim_rate.h"
 
@@ -77,6 +82,20 @@ class SlamGmappingNode {
     correction_pub_ = pnh_.advertise<geometry_msgs::TransformStamped>("correction", 10);
     if (ros::Time::isSimTime()) heartbeat_pub_ = nh_.advertise<std_msgs::Header>("/sim_heartbeat", 10);
     map_srv_ = nh_.advertiseService("dynamic_map", &SlamGmappingNode::onDynamicMap, this);
+    serialize_srv_ = pnh_.advertiseService("serialize_map", &SlamGmappingNode::onSerialize, this);
+    deserialize_srv_ = pnh_.advertiseService("deserialize_map", &SlamGmappingNode::onDeserialize, this);
+    const std::string session_path = mbot::core::sessionPath(session_file_);
+    if (!session_file_.empty() && session_path == mbot::core::sessionPath(save_session_on_exit_) &&
+        access(session_path.c_str(), F_OK) != 0 && mode_ == "mapping") {
+      // One map kept growing from run to run: the first run has none to continue.
+      ROS_INFO("slam_gmapping: no session at %s yet: starting a new map (saved there on shutdown)", session_path.c_str());
+    } else if (!session_file_.empty()) {
+      std::optional<Eigen::Vector3d> start = map_start_pose_;
+      std::string how = "near the given ~map_start_pose";
+      if (!start && map_start_at_dock_) how = "where it began (~map_start_at_dock)";
+      if (!start && !map_start_at_dock_) how = "by matching the scans against the whole map";
+      loadSession(session_file_, start, map_start_at_dock_, mode_ == "localization", how);
+    }
     scan_sub_ = nh_.subscribe("scan", scan_queue_size_, &SlamGmappingNode::onScan, this);
     if (transform_publish_period_ > 0.0) {
       tf_thread_ = std::thread([this] { publishTransformLoop(); });
@@ -86,6 +105,25 @@ class SlamGmappingNode {
 
   ~SlamGmappingNode() {
     if (tf_thread_.joinable()) tf_thread_.join();
+  }
+
+  /// ~save_session_on_exit: called after ros::spin() returns.
+  void saveOnExit() {
+    if (save_session_on_exit_.empty()) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto* graph = dynamic_cast<mbot::core::GraphSlam*>(slam_.get());
+    const std::string path = mbot::core::sessionPath(save_session_on_exit_);
+    if (!graph || graph->updates() == 0) {
+      ROS_WARN("slam_gmapping: nothing mapped; no session written to %s (~save_session_on_exit)", path.c_str());
+      return;
+    }
+    try {
+      const std::size_t bytes = mbot::core::saveSessionFile(*graph, path);
+      ROS_INFO("slam_gmapping: session saved to %s (%d nodes, %.1f MB; ~save_session_on_exit)", path.c_str(),
+               graph->updates(), bytes / 1e6);
+    } catch (const std::exception& e) {
+      ROS_ERROR("slam_gmapping: the session was not saved (~save_session_on_exit): %s", e.what());
+    }
   }
 
  private:
@@ -106,6 +144,11 @@ class SlamGmappingNode {
     correction_threshold_ = c.correction_threshold;
     scan_queue_size_ = c.scan_queue_size;
     backend_ = c.backend;
+    session_file_ = c.session_file;
+    map_start_pose_ = c.map_start_pose;
+    map_start_at_dock_ = c.map_start_at_dock;
+    mode_ = c.mode;
+    save_session_on_exit_ = c.save_session_on_exit;
     params_ = c.rbpf;
     graph_params_ = c.graph;
     graph_params_.keep_scan_poses = false;  // offline scoring only; 40 bytes a scan for as long as the node runs
@@ -166,6 +209,18 @@ class SlamGmappingNode {
       return;
     }
     const Eigen::Vector3d odom = toPose(odom_base);
+    if (slam_ && !laser_checked_) {
+      // A session loaded before any scan: its scans were taken with the laser where it was then.
+      laser_checked_ = true;
+      const Eigen::Vector3d now = toPose(base_laser);
+      const auto* graph = dynamic_cast<const mbot::core::GraphSlam*>(slam_.get());
+      const Eigen::Vector3d saved = graph ? graph->params().matcher.laser_pose : now;
+      if ((now.head<2>() - saved.head<2>()).norm() > 0.01 || std::abs(mbot::core::normalizeAngle(now.z() - saved.z())) > 0.01) {
+        ROS_WARN("slam_gmapping: the laser is at (%.3f, %.3f, %.3f) in %s, but at (%.3f, %.3f, %.3f) in the session loaded: "
+                 "the session's pose is used for every scan",
+                 now.x(), now.y(), now.z(), base_frame_.c_str(), saved.x(), saved.y(), saved.z());
+      }
+    }
     if (!slam_) {
       auto params = params_;
       params.matcher.laser_pose = toPose(base_laser);
@@ -193,23 +248,51 @@ class SlamGmappingNode {
                params.matcher.laser_pose.x(), params.matcher.laser_pose.y(), params.matcher.laser_pose.z(),
                base_frame_.c_str(), params.matcher.max_urange, params.matcher.max_range);
     }
-    bool updated, moved = false, outdated = false;
+    bool updated, moved = false, outdated = false, resuming = false;
     Eigen::Vector3d before, after;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
-      // A closure found for the last node is solved after it, in the graph's own thread: a robot
-      // that then stands still (an explorer back at its start) would keep the map of before the
-      // correction until it moved linearUpdate on, and its report would judge that map.
-      outdated = !updated && slam_->mapOutdated();
-      // gmapping moves map -> odom at its updates only; the graph (and the rbpf with
-      // scan_odometry) tracks every scan, and the graph's optimizer moves the current pose by
-      // exactly its correction, so map -> odom follows both.
-      if (updated || slam_->tracksEveryScan()) {
-        before = map_to_odom_;
-        after = map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
-        moved = true;
+      auto* graph = dynamic_cast<mbot::core::GraphSlam*>(slam_.get());
+      const bool was_resuming = graph && graph->resuming();
+      if (was_resuming && !last_resume_try_.isZero() && msg->header.stamp >= last_resume_try_ &&
+          (msg->header.stamp - last_resume_try_).toSec() < kResumeTryPeriod) {
+        // Finding the robot on the whole map takes a while: one try every kResumeTryPeriod.
+        resuming = true;
       }
+    }
+    if (resuming) {
+      beatHeartbeat(msg->header.stamp);
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto* graph = dynamic_cast<mbot::core::GraphSlam*>(slam_.get());
+      const bool was_resuming = graph && graph->resuming();
+      if (was_resuming) last_resume_try_ = msg->header.stamp;
+      updated = slam_->processScan(odom, mbot::ros_glue::fromRos(*msg), msg->header.stamp.toSec());
+      if (was_resuming) reportResume(*graph, msg->header.stamp);
+      resuming = graph && graph->resuming();
+      if (resuming) {
+        // Not on the session's map yet: no map -> odom (it would be a guess), the map served as saved.
+        if (slam_->mapOutdated()) publishMapUnlocked(msg->header.stamp);
+      } else {
+        // A closure found for the last node is solved after it, in the graph's own thread: a robot
+        // that then stands still (an explorer back at its start) would keep the map of before the
+        // correction until it moved linearUpdate on, and its report would judge that map.
+        outdated = !updated && slam_->mapOutdated();
+        // gmapping moves map -> odom at its updates only; the graph (and the rbpf with
+        // scan_odometry) tracks every scan, and the graph's optimizer moves the current pose by
+        // exactly its correction, so map -> odom follows both.
+        if (updated || slam_->tracksEveryScan()) {
+          before = map_to_odom_;
+          after = map_to_odom_ = composePose(slam_->currentPose(), inversePose(odom));
+          moved = true;
+        }
+      }
+    }
+    if (resuming) {
+      beatHeartbeat(msg->header.stamp);
+      return;
     }
     if (moved) publishScanTransform(msg->header.stamp, before, after, odom);
     if (weakest_pub_.getNumSubscribers() > 0) {
@@ -353,6 +436,132 @@ class SlamGmappingNode {
     }
   }
 
+  // The map of the graph backend, published from within the scan callback's lock (publishMap
+  // takes the node's lock for the rbpf only).
+  void publishMapUnlocked(const ros::Time& stamp) {
+    if (backend_ == "graph") publishMap(stamp);
+  }
+
+  // After a scan that tried to join a loaded session: says how it went (an error every 10 s while it
+  // does not match, one line when it does).
+  void reportResume(const mbot::core::GraphSlam& graph, const ros::Time&) {
+    if (graph.resuming()) {
+      ROS_ERROR_THROTTLE(10.0, "slam_gmapping: the robot is not found on the session's map %s yet: %s",
+                         loaded_path_.c_str(), graph.resumeFailure().c_str());
+      return;
+    }
+    const Eigen::Vector3d p = graph.currentPose();
+    ROS_INFO("slam_gmapping: the robot is at (%.2f, %.2f, %.2f rad) on the session's map %s (found %s); %s",
+             p.x(), p.y(), p.z(), loaded_path_.c_str(), resume_how_.c_str(),
+             graph.localizing() ? "localizing on it (mode localization: the graph does not grow)"
+                                : "mapping goes on from there");
+  }
+
+  // Loads the session <filename>.posegraph in place of the current map, the robot placed as
+  // resume() says. On failure the current map stays and the reason is logged; false.
+  bool loadSession(const std::string& filename, const std::optional<Eigen::Vector3d>& start, bool at_dock,
+                   bool localization, const std::string& how) {
+    const std::string path = mbot::core::sessionPath(filename);
+    std::unique_ptr<mbot::core::GraphSlam> loaded;
+    std::string notes;
+    try {
+      const std::string bytes = mbot::core::readSessionFile(path);
+      auto params = params_;
+      auto graph = graph_params_;
+      params.shareWith(graph);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (const auto* current = dynamic_cast<const mbot::core::GraphSlam*>(slam_.get())) {
+          graph.matcher = current->params().matcher;  // the laser as this robot has it
+        }
+      }
+      loaded = mbot::core::GraphSlam::loadSession(bytes, graph, &notes);
+    } catch (const std::exception& e) {
+      ROS_ERROR("slam_gmapping: cannot load the session %s: %s; %s", path.c_str(), e.what(),
+                slam_ ? "the current map stays" : "starting a new map");
+      return false;
+    }
+    if (!notes.empty()) ROS_WARN("slam_gmapping: session %s: %s", path.c_str(), notes.c_str());
+    loaded->resume(at_dock && !start ? std::optional<Eigen::Vector3d>(loaded->firstPose()) : start, localization);
+    const int nodes = loaded->updates();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      slam_ = std::move(loaded);
+      laser_checked_ = false;
+      last_resume_try_ = ros::Time();
+      loaded_path_ = path;
+      resume_how_ = how;
+      last_map_update_ = ros::Time();
+    }
+    ROS_INFO("slam_gmapping: loaded the session %s (%d nodes); finding the robot on it %s", path.c_str(), nodes,
+             how.c_str());
+    return true;
+  }
+
+  bool onSerialize(mbot_slam_navigation::SerializePoseGraph::Request& req,
+                   mbot_slam_navigation::SerializePoseGraph::Response& res) {
+    res.result = mbot_slam_navigation::SerializePoseGraph::Response::RESULT_FAILED_TO_WRITE_FILE;
+    const std::string path = mbot::core::sessionPath(req.filename.empty() ? "map" : req.filename);
+    std::lock_guard<std::mutex> lock(mutex_);  // no scan meanwhile
+    auto* graph = dynamic_cast<mbot::core::GraphSlam*>(slam_.get());
+    if (!graph) {
+      ROS_ERROR("slam_gmapping: ~serialize_map: %s", slam_ ? "sessions are the graph backend's (~backend graph)"
+                                                              : "nothing mapped yet");
+      return true;
+    }
+    try {
+      const std::size_t bytes = mbot::core::saveSessionFile(*graph, path);
+      ROS_INFO("slam_gmapping: session saved to %s (%d nodes, %.1f MB)", path.c_str(), graph->updates(), bytes / 1e6);
+      res.result = mbot_slam_navigation::SerializePoseGraph::Response::RESULT_SUCCESS;
+    } catch (const std::exception& e) {
+      ROS_ERROR("slam_gmapping: ~serialize_map: %s", e.what());
+    }
+    return true;
+  }
+
+  bool onDeserialize(mbot_slam_navigation::DeserializePoseGraph::Request& req,
+                     mbot_slam_navigation::DeserializePoseGraph::Response& res) {
+    using Req = mbot_slam_navigation::DeserializePoseGraph::Request;
+    using Res = mbot_slam_navigation::DeserializePoseGraph::Response;
+    if (req.filename.empty()) {
+      ROS_ERROR("slam_gmapping: ~deserialize_map: no filename given");
+      res.result = Res::RESULT_INVALID_FILENAME;
+      return true;
+    }
+    if (backend_ != "graph") {
+      ROS_ERROR("slam_gmapping: ~deserialize_map: sessions are the graph backend's (~backend graph)");
+      res.result = Res::RESULT_UNDEFINED_FAILURE;
+      return true;
+    }
+    const Eigen::Vector3d given(req.initial_pose.x, req.initial_pose.y, req.initial_pose.theta);
+    std::optional<Eigen::Vector3d> start;
+    bool dock = false, localization = false;
+    std::string how;
+    switch (req.match_type) {
+      case Req::UNSET:
+        how = "by matching the scans against the whole map";
+        break;
+      case Req::START_AT_FIRST_NODE:
+        dock = true;
+        how = "where it began (START_AT_FIRST_NODE)";
+        break;
+      case Req::START_AT_GIVEN_POSE:
+      case Req::LOCALIZE_AT_POSE:
+        start = given;
+        localization = req.match_type == Req::LOCALIZE_AT_POSE;
+        how = "near the initial_pose given";
+        break;
+      default:
+        ROS_ERROR("slam_gmapping: ~deserialize_map: match_type %d is none of UNSET (0), START_AT_FIRST_NODE (1), "
+                  "START_AT_GIVEN_POSE (2), LOCALIZE_AT_POSE (3)", req.match_type);
+        res.result = Res::RESULT_UNDEFINED_FAILURE;
+        return true;
+    }
+    res.result = loadSession(req.filename, start, dock, localization, how) ? Res::RESULT_SUCCESS
+                                                                            : Res::RESULT_FAILED_TO_READ_FILE;
+    return true;
+  }
+
   bool onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& res) {
     std::lock_guard<std::mutex> lock(map_mutex_);
     if (!last_map_ || last_map_->data.empty()) return false;  // gmapping answers false until it has a map
@@ -405,7 +614,15 @@ class SlamGmappingNode {
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_;
   ros::Subscriber scan_sub_;
-  ros::ServiceServer map_srv_;
+  ros::ServiceServer map_srv_, serialize_srv_, deserialize_srv_;
+  // Sessions (slam_config.h).
+  std::string session_file_, mode_, save_session_on_exit_;
+  std::optional<Eigen::Vector3d> map_start_pose_;
+  bool map_start_at_dock_ = false;
+  bool laser_checked_ = true;       // the laser's pose compared with a loaded session's
+  std::string loaded_path_, resume_how_;  // the session loaded and how the robot is found on it
+  ros::Time last_resume_try_;             // the scan that last tried to join a loaded session
+  static constexpr double kResumeTryPeriod = 0.5;  // [s] of scan time between tries
   std::mutex mutex_, map_mutex_;
   // Stamps of map -> odom lately sent by the broadcast loop and by the scan callback (stamp_mutex_).
   static constexpr std::size_t kStampMemory = 256;
@@ -436,6 +653,7 @@ int main(int argc, char** argv) {
   try {
     SlamGmappingNode node;
     ros::spin();
+    node.saveOnExit();
   } catch (const mbot::core::ParamError&) {
     return 1;  // already logged
   }

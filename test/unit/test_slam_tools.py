@@ -56,10 +56,9 @@ def test_relations_metric():
     assert pose_at(times, poses, 100.0) is None  # no estimate near that time
 
 
-@pytest.mark.parametrize('backend, params', [('rbpf', ['particles=5']), ('graph', ['loop_candidates=2'])])
-def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
-    """A bag recorded from the simulator's topics (/scan, /odom) goes through slam_offline, with
-    either backend and its own parameters."""
+def _room_drive_bag(tmp_path):
+    """(a bag of the simulator's /scan and /odom: the mbot in a furnished 8 x 6 m room driving 15 s
+    forward, turning, forward; the robot's final pose, spawned at (-2.5, -1.0, 0))."""
     import rosbag
     import rospy
     from nav_msgs.msg import Odometry
@@ -67,7 +66,6 @@ def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
 
     from mbot_slam_navigation.sim.sdf_world import World, Shape
     from mbot_slam_navigation.sim.simulation import Simulation
-    from mbot_slam_navigation.slam.offline import main
     from mbot_slam_navigation.transforms import yaw_to_quaternion
     from test_simulation import robot_spec
 
@@ -98,6 +96,16 @@ def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
                     s.angle_min, s.angle_increment, s.range_min, s.range_max
                 scan.ranges = sim.scan(robot, robot.lasers[0]).tolist()
                 bag.write('/scan', scan, stamp)
+    return bag_path, robot.pose
+
+
+@pytest.mark.parametrize('backend, params', [('rbpf', ['particles=5']), ('graph', ['loop_candidates=2'])])
+def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
+    """A bag recorded from the simulator's topics (/scan, /odom) goes through slam_offline, with
+    either backend and its own parameters."""
+    from mbot_slam_navigation.slam.offline import main
+
+    bag_path, final = _room_drive_bag(tmp_path)
     out = str(tmp_path / 'drive')
     extra = [a for p in params for a in ('--param', p)]
     assert main([bag_path, '-o', out, '--quiet', '--backend', backend, '--param', 'maxUrange=9.5',
@@ -105,9 +113,46 @@ def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
     traj = np.loadtxt(out + '.traj')
     assert traj.shape[1] == 4 and len(traj) == 150
     # The map frame starts at the first odometry pose (the spawn pose's odom is 0): compare motion.
-    true_motion = relative2d((-2.5, -1.0, 0.0), robot.pose)
+    true_motion = relative2d((-2.5, -1.0, 0.0), final)
     assert np.hypot(traj[-1, 1] - true_motion[0], traj[-1, 2] - true_motion[1]) < 0.1
     assert os.path.exists(out + '.pgm') and os.path.exists(out + '.yaml')
+
+
+def test_a_log_mapped_in_two_sessions_ends_where_one_run_does(tmp_path, capsys):
+    """slam_offline --session-out on the first half, --session-in on the second: the second half
+    joins the saved map (given the pose where the first ended, or found by matching) and its
+    trajectory covers both halves; --localize tracks on the saved map."""
+    from mbot_slam_navigation.slam.offline import main
+
+    bag_path, final = _room_drive_bag(tmp_path)
+    common = ['--quiet', '--param', 'maxUrange=9.5', '--param', 'maxRange=10', '--param', 'linearUpdate=0.2',
+              '--param', 'angularUpdate=0.2']
+    session = str(tmp_path / 'half')
+    assert main([bag_path, '-o', str(tmp_path / 'one'), '--scans', '0:75', '--session-out', session] + common) == 0
+    assert os.path.isfile(session + '.posegraph')
+    end = np.loadtxt(str(tmp_path / 'one.traj'))[-1, 1:4]
+    true_motion = relative2d((-2.5, -1.0, 0.0), final)
+    for how, extra in (('pose', ['--start-pose', '%f,%f,%f' % tuple(end)]), ('matching', []),
+                       ('localize', ['--start-pose', '%f,%f,%f' % tuple(end), '--localize'])):
+        out = str(tmp_path / how)
+        assert main([bag_path, '-o', out, '--scans', '75:', '--session-in', session] + extra + common) == 0, how
+        traj = np.loadtxt(out + '.traj')
+        assert len(traj) == (75 if how == 'localize' else 150), how
+        assert np.hypot(traj[-1, 1] - true_motion[0], traj[-1, 2] - true_motion[1]) < 0.1, how
+    # bad sessions: one message naming the file and what is wrong, exit status 2
+    with open(session + '.posegraph', 'rb') as f:
+        good = f.read()
+    for name, content, message in (('missing', None, 'no such file'), ('truncated', good[:len(good) // 2], 'truncated'),
+                                   ('image', b'P5\n2 2\n255\n\0\0\0\0', 'not a session')):
+        path = str(tmp_path / name)
+        if content is not None:
+            with open(path + '.posegraph', 'wb') as f:
+                f.write(content)
+        with pytest.raises(SystemExit) as exit_:
+            main([bag_path, '-o', str(tmp_path / 'x'), '--scans', '75:', '--session-in', path] + common)
+        assert exit_.value.code == 2
+        err = capsys.readouterr().err
+        assert path + '.posegraph' in err and message in err, err
 
 
 def test_a_bag_recorded_live_gives_each_scan_the_odometry_at_its_stamp(tmp_path):

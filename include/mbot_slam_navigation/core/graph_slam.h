@@ -284,7 +284,7 @@ class GraphSlam : public SlamBackend {
   // Sessions (slam_toolbox's serialize_map / deserialize_map). A session file holds a format
   // version, the backend's name, the laser's pose and ranges the scans were taken with, every
   // node (pose, odometry, time, distance travelled, its scan if kept, how it was merged), the
-  // edges and the submaps' node ranges; its last 8 bytes are a checksum of the rest, so a
+  // edges, the submaps' node ranges and the tracked scans' poses (keep_scan_poses); its last 8 bytes are a checksum of the rest, so a
   // truncated or damaged file is told from a good one. Binary, little-endian.
 
   /// Writes the session to `out` (waits for the closure search of the nodes so far: flush()).
@@ -347,7 +347,7 @@ class GraphSlam : public SlamBackend {
   /// processScan while resuming: finds the scan on the session's map and joins it (graph_session.cpp).
   bool resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s);
   /// processScan in localization mode after the robot was found: tracks the scan only.
-  bool localize(const Eigen::Vector3d& odom, const LaserScan& scan);
+  bool localize(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s);
   /// A local map of the saved nodes nearest `pose` (those with their scans, within the match
   /// reach), in the map frame; null if none (mutex_ held for the node list).
   std::unique_ptr<LikelihoodGrid> sessionMapNearLocked(const Eigen::Vector3d& pose, Visibility* seen) const;
@@ -452,6 +452,16 @@ class GraphSlam : public SlamBackend {
 
   std::thread worker_;
 };
+
+/// The session file of a slam_toolbox-style `filename` (the path without extension):
+/// <filename>.posegraph, with a leading ~ expanded ($HOME); a filename ending in .posegraph is kept.
+std::string sessionPath(const std::string& filename);
+/// Saves `slam`'s session to `path` atomically: written to a temporary file beside it, flushed to
+/// disk and renamed over it, so that a crash mid-write leaves the last good file. Returns the
+/// bytes written; throws std::runtime_error naming the path and the reason.
+std::size_t saveSessionFile(GraphSlam& slam, const std::string& path);
+/// The contents of the session file `path`; throws SessionError (missing, a directory, unreadable).
+std::string readSessionFile(const std::string& path);
 
 }  // namespace core
 }  // namespace mbot

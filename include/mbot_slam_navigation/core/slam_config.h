@@ -3,7 +3,10 @@
 // (slam_gmapping_node.cpp), the offline runner (slam/backends.py) and the reference page.
 #pragma once
 
+#include <optional>
 #include <string>
+
+#include <Eigen/Core>
 
 #include "mbot_slam_navigation/core/graph_slam.h"
 #include "mbot_slam_navigation/core/params.h"
@@ -22,6 +25,13 @@ struct SlamConfig {
   int scan_queue_size = 100;               ///< scans held while the node is busy (gmapping: 5)
   double correction_threshold = 0.1;       ///< [m] a correction this large is published on ~correction
   std::string backend = "graph";           ///< graph or rbpf
+  // Sessions (graph backend; slam_toolbox's names): a saved graph to start from, where the robot
+  // is on it, whether the graph grows, and a file written at shutdown. Paths without extension.
+  std::string session_file;                ///< start from <session_file>.posegraph ('' : a new map)
+  std::optional<Eigen::Vector3d> map_start_pose;  ///< [m, m, rad] the robot's base in the session's map
+  bool map_start_at_dock = false;          ///< the robot stands where the session began
+  std::string mode = "mapping";            ///< mapping or localization (on a session)
+  std::string save_session_on_exit;        ///< written to <this>.posegraph when the node shuts down
   /// The particle filter's parameters with the matcher, update thresholds and map extent both
   /// backends share; the matcher's laser pose and, when <= 0, max ranges are the caller's to set.
   RbpfParams rbpf;

@@ -117,6 +117,35 @@ class GraphSlam(_Backend):
         """(from, to) node indices of the accepted loop closures."""
         return [(f, t) for f, t, _, _, _, closure in self.edges() if closure]
 
+    def save_session(self, filename: str) -> str:
+        """Writes the session to <filename>.posegraph (atomically); returns that path."""
+        path = _core.session_path(filename)
+        self._impl.save_session(path)
+        return path
+
+    @classmethod
+    def load_session(cls, filename: str, params=None, laser_pose=(0.0, 0.0, 0.0), background=False, **graph_params):
+        """(GraphSlam holding the session <filename>.posegraph, notes on parameters that differ from
+        the session's). Raises _core.SessionError (a ValueError) naming the file and what is wrong."""
+        slam = cls.__new__(cls)
+        slam._impl, notes = _core._GraphSlam.load_session(
+            _core.session_path(filename), params or make_graph_params(graph_params, laser_pose, background))
+        return slam, notes
+
+    def resume(self, pose=None, localization: bool = False) -> None:
+        """How the next scans join a loaded session: near `pose` (x, y, yaw in its map), or anywhere
+        (global matching) without; with `localization` the graph does not grow."""
+        self._impl.resume(None if pose is None else [float(v) for v in pose], localization)
+
+    def resuming(self) -> bool:
+        return self._impl.resuming()
+
+    def resume_failure(self) -> str:
+        return self._impl.resume_failure()
+
+    def first_pose(self) -> Tuple[float, float, float]:
+        return self._impl.first_pose()
+
 
 def make_slam(backend: str, params: Dict[str, float], laser_pose=(0.0, 0.0, 0.0), background=False):
     """background: the graph's loop closure in its own thread, as the node runs it (the particle

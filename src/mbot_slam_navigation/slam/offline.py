@@ -3,7 +3,9 @@
 Writes OUT.traj (`t x y theta` per scan: the estimated trajectory, with odometry between its map
 updates), OUT.pgm/OUT.yaml (map_server format) and OUT.timing.json (CPU seconds, scans, updates).
 Usage: slam_offline LOG [-o OUT] [--backend graph|rbpf] [--relations FILE] [--param name=value ...]
-[--quiet]
+[--quiet] [--scans FROM:TO] [--session-out NAME] [--session-in NAME [--start-pose X,Y,YAW |
+--start-at-dock] [--localize]]. With sessions a log can be mapped in parts: the first part saved,
+the next continued from it (the trajectory written then covers both parts, as the graph holds them).
 """
 import argparse
 import json
@@ -15,7 +17,7 @@ import numpy as np
 
 from mbot_slam_navigation.maps.map_io import save_map
 from mbot_slam_navigation.slam.carmen import read_log
-from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, make_slam
+from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, GraphSlam, make_slam
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
 from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw, relative2d
 
@@ -32,12 +34,20 @@ def per_scan_poses(trajectory: np.ndarray, scans) -> np.ndarray:
 
 
 def estimated_poses(slam, scans) -> np.ndarray:
-    """The backend's pose at every scan: the graph's tracked scan poses, or (the particle filter)
-    its trajectory moved on by odometry."""
+    """The backend's pose at every scan: the graph's tracked scan poses (matched by time: a session
+    continued holds the saved part's too, and scans that came before the robot was found on it have
+    none), else (the particle filter, those scans) its trajectory moved on by odometry."""
     if hasattr(slam, 'scan_poses'):
         tracked = slam.scan_poses()
         if len(tracked) == len(scans):
             return tracked[:, 1:4]
+        out = per_scan_poses(slam.trajectory(), scans)
+        if len(tracked):
+            times = np.array([s.time for s in scans])
+            k = np.clip(np.searchsorted(tracked[:, 0], times), 0, len(tracked) - 1)
+            same = tracked[k, 0] == times
+            out[same] = tracked[k[same], 1:4]
+        return out
     return per_scan_poses(slam.trajectory(), scans)
 
 
@@ -110,15 +120,17 @@ class Progress:
         sys.stderr.flush()
 
 
-def run(scans, params, progress=True, backend=DEFAULT_BACKEND, rate=0.0, background=False, online=None):
+def run(scans, params, progress=True, backend=DEFAULT_BACKEND, rate=0.0, background=False, online=None, slam=None):
     """Runs a backend over the scans; returns (slam, cpu_seconds). The CPU time is the process's,
     so it counts every thread (the graph backend runs synchronously here, on one core, unless
     `background`: then its loop closure runs in its own thread, as in the slam_gmapping node).
     rate > 0 feeds the scans no faster than `rate` times the log's own time (as `rosbag play -r`
     feeds a node), so that the CPU compares with a node's: a process that waits between scans
     finds its caches cold and costs more than one that runs flat out. `online`, a list, receives
-    the pose the backend gives each scan as it is processed (what a node publishes then)."""
-    slam = make_slam(backend, params, scans[0].laser_pose, background=background)
+    the pose the backend gives each scan as it is processed (what a node publishes then). `slam`:
+    a backend to go on with (a loaded session) instead of a new one."""
+    if slam is None:
+        slam = make_slam(backend, params, scans[0].laser_pose, background=background)
     bar = Progress(len(scans), progress)
     cpu = 0.0
     wall0, t0, start = time.time(), scans[0].time, time.process_time()
@@ -157,7 +169,36 @@ def argument_parser() -> argparse.ArgumentParser:
     ap.add_argument('--backend', choices=BACKENDS, default=DEFAULT_BACKEND, help='SLAM backend (default %(default)s)')
     ap.add_argument('--param', action='append', type=parse_param, default=[], help='slam_gmapping name=value')
     ap.add_argument('--quiet', action='store_true', help='no progress bar')
+    ap.add_argument('--scans', metavar='FROM:TO', type=parse_slice, default=slice(None),
+                    help='process only these scans (Python slice of their indices, e.g. 0:5000 or 5000:)')
+    ap.add_argument('--session-out', metavar='NAME', help='write the session to NAME.posegraph at the end (graph)')
+    ap.add_argument('--session-in', metavar='NAME',
+                    help='start from the session NAME.posegraph (graph); the robot found on its map by matching the '
+                         'first scans, unless --start-pose or --start-at-dock')
+    ap.add_argument('--start-pose', metavar='X,Y,YAW', type=parse_pose, help='with --session-in: the robot near here')
+    ap.add_argument('--start-at-dock', action='store_true', help='with --session-in: where the session began')
+    ap.add_argument('--localize', action='store_true',
+                    help='with --session-in: track on the saved map only (slam_gmapping mode localization)')
     return ap
+
+
+def parse_slice(text):
+    a, sep, b = text.partition(':')
+    try:
+        if not sep:
+            raise ValueError
+        return slice(int(a) if a else None, int(b) if b else None)
+    except ValueError:
+        raise argparse.ArgumentTypeError('--scans takes FROM:TO (scan indices, either may be left out), got "%s"'
+                                         % text) from None
+
+
+def parse_pose(text):
+    try:
+        x, y, yaw = (float(v) for v in text.split(','))
+        return x, y, yaw
+    except ValueError:
+        raise argparse.ArgumentTypeError('--start-pose takes X,Y,YAW (metres, radians), got "%s"' % text) from None
 
 
 def main(argv=None):
@@ -170,11 +211,36 @@ def main(argv=None):
     except ValueError as e:  # CarmenError, BagError: the file and what is wrong with it
         ap.exit(2, 'slam_offline: %s\n' % e)
     params = dict(args.param)
+    if (args.session_in or args.session_out) and args.backend != 'graph':
+        ap.error('sessions are the graph backend\'s (--backend graph)')
+    if (args.start_pose or args.start_at_dock or args.localize) and not args.session_in:
+        ap.error('--start-pose, --start-at-dock and --localize go with --session-in')
+    before = scans[:args.scans.start or 0] if args.session_in else []
+    scans = scans[args.scans]
+    if not scans:
+        ap.error('--scans %s leaves no scan' % (args.scans,))
+    slam = None
+    if args.session_in:
+        try:
+            slam, notes = GraphSlam.load_session(args.session_in, laser_pose=scans[0].laser_pose, **params)
+        except KeyError as e:
+            ap.error(e.args[0])
+        except ValueError as e:  # SessionError: the file and what is wrong with it
+            ap.exit(2, 'slam_offline: %s\n' % e)
+        if notes:
+            print('slam_offline: %s' % notes)
+        slam.resume(slam.first_pose() if args.start_at_dock else args.start_pose, args.localize)
     try:
-        slam, cpu = run(scans, params, progress=not args.quiet, backend=args.backend)
+        slam, cpu = run(scans, params, progress=not args.quiet, backend=args.backend, slam=slam)
     except KeyError as e:
         ap.error(e.args[0])
+    if args.session_in and slam.resuming():
+        ap.exit(3, 'slam_offline: no scan joined the session %s: %s\n' % (args.session_in, slam.resume_failure()))
+    if args.session_out:
+        print('slam_offline: session written to %s' % slam.save_session(args.session_out))
     out = args.out or os.path.basename(args.log).split('.')[0]
+    if args.session_in and not args.localize:
+        scans = before + scans  # the whole trajectory, the session's scans too, as the graph holds it now
     poses = estimated_poses(slam, scans)
     times = np.array([s.time for s in scans])
     np.savetxt(out + '.traj', np.column_stack([times, poses]), fmt='%.6f', header='t x y theta')
