@@ -343,14 +343,16 @@ std::unique_ptr<LikelihoodGrid> GraphSlam::sessionMapNearLocked(const Eigen::Vec
     std::nth_element(near.begin(), near.begin() + wanted, near.end());
     near.resize(wanted);
   }
+  std::vector<std::pair<Eigen::Vector3d, const LaserScan*>> members;
+  for (const auto& [d, k] : near) members.emplace_back(nodes_[k].pose, nodes_[k].scan.get());
+  for (const auto& [pose_k, scan_k] : temporary_) members.emplace_back(pose_k, scan_k.get());
   std::vector<Eigen::Vector2d> reference;
   if (seen) seen->clear();
-  for (const auto& [d, k] : near) {
-    const Node& n = nodes_[k];
-    const std::vector<Eigen::Vector2d> points = surfacePoints(*n.scan, params_.matcher.laser_pose, reach, params_.delta);
-    const double c = std::cos(n.pose.z()), s = std::sin(n.pose.z());
-    for (const auto& q : points) reference.emplace_back(n.pose.x() + c * q.x() - s * q.y(), n.pose.y() + s * q.x() + c * q.y());
-    if (seen) seen->add(*n.scan, params_.matcher.laser_pose, n.pose, reach);
+  for (const auto& [at, scan] : members) {
+    const std::vector<Eigen::Vector2d> points = surfacePoints(*scan, params_.matcher.laser_pose, reach, params_.delta);
+    const double c = std::cos(at.z()), s = std::sin(at.z());
+    for (const auto& q : points) reference.emplace_back(at.x() + c * q.x() - s * q.y(), at.y() + s * q.x() + c * q.y());
+    if (seen) seen->add(*scan, params_.matcher.laser_pose, at, reach);
   }
   if (reference.empty()) return nullptr;
   return std::make_unique<LikelihoodGrid>(reference, params_.delta, localSigma());
@@ -441,6 +443,8 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
   linear_distance_ = angular_distance_ = 0.0;
   last_update_time_ = time_s;
   if (localization_) {
+    temporary_.clear();
+    temporary_.emplace_back(found, std::make_shared<const LaserScan>(scan));
     local_map_ = sessionMapNearLocked(found, &local_seen_);
     local_anchor_ = nodes_.back().pose;  // currentPose(): the last node composed with the track since it
     track_pose_ = found;
@@ -476,17 +480,9 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
 
 bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s) {
   Eigen::Vector3d predicted;
-  bool rebuild;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     predicted = composePose(track_pose_, relativePose(track_odom_, odom));
-    rebuild = (predicted.head<2>() - localized_at_.head<2>()).norm() > params_.linear_update ||
-              std::abs(normalizeAngle(predicted.z() - localized_at_.z())) > params_.angular_update;
-    if (rebuild) {
-      // The saved nodes around the robot now: a rolling local map, nothing added to the graph.
-      local_map_ = sessionMapNearLocked(predicted, &local_seen_);
-      localized_at_ = predicted;
-    }
   }
   std::vector<Eigen::Vector2d> points = matchPoints(scan, params_.matcher.laser_pose, matchReach(), params_.delta);
   if (params_.local_visible_only && !local_seen_.empty()) {
@@ -499,6 +495,16 @@ bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan, dou
   track_pose_ = tracked;
   if (params_.keep_scan_poses) {
     scans_.push_back({time_s, session_start_ - 1, relativePose(local_anchor_, tracked)});
+  }
+  if ((tracked.head<2>() - localized_at_.head<2>()).norm() > kLocalizeRebuild) {
+    // slam_toolbox's rolling window: the last few scans as temporary nodes beside the saved nodes
+    // nearest the robot, so that it is tracked also against what it has just seen (where the
+    // session saw a room only from its door, the saved nodes alone lost the track on FR079), and
+    // the local map is built again around it. Nothing is added to the graph.
+    temporary_.emplace_back(tracked, std::make_shared<const LaserScan>(scan));
+    if (temporary_.size() > kTemporaryNodes) temporary_.pop_front();
+    local_map_ = sessionMapNearLocked(tracked, &local_seen_);
+    localized_at_ = tracked;
   }
   return false;
 }

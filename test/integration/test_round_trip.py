@@ -9,19 +9,15 @@
    (random_navigation.py's table) in turn, checked against the simulator's ground truth.
 Tests run in order.
 """
-import math
 import unittest
 
 import rospy
 import rostest
-from actionlib_msgs.msg import GoalStatus
-from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import Odometry
 
 from mbot_slam_navigation.msg import Contact
-from mbot_slam_navigation.nav.action_client import SimpleActionClient
-from mbot_slam_navigation.nav.random_navigation import tutorial_locations
 from explore_result import wait_for_report
+from tutorial_points import reach_tutorial_points
 
 GOAL_TIMEOUT = 240.0  # [s] simulated, per point: a path across the home takes under 100 s
 XY_TOL = 0.1 + 0.1    # [m] xy_goal_tolerance, and localization on a map SLAM made
@@ -50,23 +46,7 @@ class RoundTripTest(unittest.TestCase):
                       r['exploration_time_s'], 100 * r['coverage_of_reachable_free'], 100 * r['walls_within_tolerance'])
 
     def test_2_move_base_reaches_the_tutorial_points(self):
-        client = SimpleActionClient('move_base', MoveBaseAction)
-        self.assertTrue(client.wait_for_server(rospy.Duration(30.0)), 'no move_base action server')
-        for loc in tutorial_locations():
-            goal = MoveBaseGoal()
-            goal.target_pose.header.frame_id = 'map'
-            goal.target_pose.header.stamp = rospy.Time.now()
-            goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = loc.x, loc.y
-            (goal.target_pose.pose.orientation.x, goal.target_pose.pose.orientation.y,
-             goal.target_pose.pose.orientation.z, goal.target_pose.pose.orientation.w) = loc.orientation
-            client.send_goal(goal)
-            finished = client.wait_for_result(rospy.Duration(GOAL_TIMEOUT))
-            state = client.get_state()
-            self.assertTrue(finished and state == GoalStatus.SUCCEEDED,
-                            '%s (%s, %.2f, %.2f): %s' % (loc.name, loc.room, loc.x, loc.y,
-                                                        client.get_goal_status_text() or 'no result in time'))
-            p = self.truth
-            self.assertLess(math.hypot(p.x - loc.x, p.y - loc.y), XY_TOL, loc.name)
+        reach_tutorial_points(self, lambda: self.truth, GOAL_TIMEOUT, XY_TOL)
         self.assertEqual(self.contacts, [])
 
 

@@ -1,8 +1,14 @@
 #!/usr/bin/env python3
-"""A SLAM session saved halfway through the home's exploration, the node killed and started
-again from it (slam_session.test): the session file is written and small, the restarted node serves
-the saved map at once and finds the robot on it (within 0.1 m of the truth) by matching, and the
-exploration, continued on it, finishes into one map with the walls where the world has them."""
+"""SLAM sessions in the home (slam_session.test). Tests run in order.
+
+1. The session is saved halfway through the exploration (~serialize_map), slam_gmapping killed and
+   started again from it (~session_file): the file is written and small, the restarted node serves
+   the saved map at once and finds the robot on it (within 0.1 m of the truth) by matching, and
+   the exploration, continued on it, finishes into one map with the walls where the world has them.
+2. The finished session saved again, slam_gmapping started in localization mode on it (the robot
+   back at its dock, where the session began) stands in for amcl: move_base reaches the tutorial's
+   nine points, checked against the simulator's ground truth.
+"""
 import math
 import os
 import subprocess
@@ -19,9 +25,12 @@ from tf2_ros import Buffer, TransformListener
 from mbot_slam_navigation.msg import Contact
 from mbot_slam_navigation.srv import SerializePoseGraph, SerializePoseGraphResponse
 from explore_result import wait_for_report
+from tutorial_points import reach_tutorial_points
 
 HALF_S = 90.0        # [s] simulated exploration before the session is saved (the home takes 180-260 s)
 WAIT_S = 300.0       # [s] wall, for each step
+GOAL_TIMEOUT = 240.0  # [s] simulated, per tutorial point
+XY_TOL = 0.1 + 0.1    # [m] xy_goal_tolerance, and localization on a map SLAM made
 
 
 def known_m2(msg):
@@ -30,28 +39,41 @@ def known_m2(msg):
 
 
 class SlamSessionTest(unittest.TestCase):
-    def setUp(self):
-        self.map = None
-        self.truth = None
-        rospy.Subscriber('/map', OccupancyGrid, self.on_map, queue_size=1, buff_size=2 ** 24)
-        rospy.Subscriber('/base_pose_ground_truth', Odometry, self.on_truth, queue_size=1)
-        self.tf = Buffer(rospy.Duration(30.0))
-        TransformListener(self.tf)
-        self.restarted = None
+    contacts = []
+    map = None
+    truth = None
+    node = None  # slam_gmapping as the test started it
 
-    def tearDown(self):
-        if self.restarted is not None and self.restarted.poll() is None:
-            self.restarted.terminate()
+    @classmethod
+    def setUpClass(cls):
+        rospy.Subscriber('/map', OccupancyGrid, cls.on_map, queue_size=1, buff_size=2 ** 24)
+        rospy.Subscriber('/base_pose_ground_truth', Odometry, cls.on_truth, queue_size=1)
+        rospy.Subscriber('/gazebo/contacts', Contact, cls.contacts.append)
+        cls.tf = Buffer(rospy.Duration(30.0))
+        cls.listener = TransformListener(cls.tf)
+        cls.session = rospy.get_param('~session')
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.stop_node()
+
+    @classmethod
+    def on_map(cls, msg):
+        cls.map = msg
+
+    @classmethod
+    def on_truth(cls, msg):
+        cls.truth = msg
+
+    @classmethod
+    def stop_node(cls):
+        if cls.node is not None and cls.node.poll() is None:
+            cls.node.terminate()
             try:
-                self.restarted.wait(20.0)
+                cls.node.wait(20.0)
             except subprocess.TimeoutExpired:
-                self.restarted.kill()
-
-    def on_map(self, msg):
-        self.map = msg
-
-    def on_truth(self, msg):
-        self.truth = msg
+                cls.node.kill()
+        cls.node = None
 
     def wait(self, what, ok, timeout=WAIT_S):
         end = time.monotonic() + timeout
@@ -72,31 +94,34 @@ class SlamSessionTest(unittest.TestCase):
         p = self.truth.pose.pose.position
         return math.hypot(t.transform.translation.x - p.x, t.transform.translation.y - p.y)
 
-    def test_a_session_saved_and_continued_finishes_the_exploration(self):
-        contacts = []
-        rospy.Subscriber('/gazebo/contacts', Contact, contacts.append)
-        session = rospy.get_param('~session')
-        path = session + '.posegraph'
+    def save(self):
+        """Saves the session; returns its size [MB]."""
+        rospy.wait_for_service('/slam_gmapping/serialize_map', 30.0)
+        save = rospy.ServiceProxy('/slam_gmapping/serialize_map', SerializePoseGraph)
+        self.assertEqual(save(self.session).result, SerializePoseGraphResponse.RESULT_SUCCESS)
+        path = self.session + '.posegraph'
+        self.assertTrue(os.path.isfile(path))
+        return os.path.getsize(path) / 1e6
+
+    def restart(self, *params):
+        """Kills slam_gmapping and starts it again with its parameters plus `params` (_name:=value)."""
+        rosnode.kill_nodes(['/slam_gmapping'])
+        self.wait('slam_gmapping gone', lambda: not rosnode.rosnode_ping('/slam_gmapping', max_count=1), 30.0)
+        self.stop_node()
+        type(self).map = None
+        type(self).node = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=slam_gmapping',
+                                            'scan:=/scan', '_session_file:=' + self.session] + list(params))
+
+    def test_1_a_session_saved_and_continued_finishes_the_exploration(self):
+        path = self.session + '.posegraph'
         if os.path.exists(path):
             os.remove(path)
         self.wait('half the exploration', lambda: self.map is not None and rospy.get_time() >= HALF_S)
-
-        rospy.wait_for_service('/slam_gmapping/serialize_map', 30.0)
-        save = rospy.ServiceProxy('/slam_gmapping/serialize_map', SerializePoseGraph)
-        self.assertEqual(save(session).result, SerializePoseGraphResponse.RESULT_SUCCESS)
-        self.assertTrue(os.path.isfile(path))
-        size_mb = os.path.getsize(path) / 1e6
+        size_mb = self.save()
         self.assertLess(size_mb, 20.0)
         before = known_m2(self.map)
-
-        rosnode.kill_nodes(['/slam_gmapping'])
-        self.wait('slam_gmapping gone', lambda: not rosnode.rosnode_ping('/slam_gmapping', max_count=1), 30.0)
-        self.map = None
-        rospy.set_param('/slam_gmapping/session_file', session)
-        env = dict(os.environ)
         started = time.monotonic()
-        self.restarted = subprocess.Popen(['rosrun', 'mbot_slam_navigation', 'slam_gmapping', '__name:=slam_gmapping',
-                                           'scan:=/scan'], env=env)
+        self.restart()
         # the saved map at once (the first scan publishes it), then the robot found on it
         self.wait('the saved map served again', lambda: self.map is not None, 60.0)
         map_s = time.monotonic() - started
@@ -111,9 +136,17 @@ class SlamSessionTest(unittest.TestCase):
         self.assertGreaterEqual(r['coverage_of_reachable_free'], 0.95)
         self.assertGreaterEqual(r['walls_within_tolerance'], 0.99)
         self.assertEqual(r['collisions'], 0)
-        self.assertEqual(contacts, [])
+        self.assertEqual(self.contacts, [])
         rospy.loginfo('continued exploration: %.0f s simulated, coverage %.1f%%, walls %.1f%% within 0.1 m',
                       r['exploration_time_s'], 100 * r['coverage_of_reachable_free'], 100 * r['walls_within_tolerance'])
+
+    def test_2_localization_on_the_session_takes_move_base_to_the_tutorial_points(self):
+        self.save()
+        self.restart('_mode:=localization', '_map_start_at_dock:=true')
+        self.wait('the robot localized at its dock', lambda: self.pose_error() < 0.1, 120.0)
+        reach_tutorial_points(self, lambda: self.truth.pose.pose.position, GOAL_TIMEOUT, XY_TOL)
+        self.assertLess(self.pose_error(), 0.1)
+        self.assertEqual(self.contacts, [])
 
 
 if __name__ == '__main__':

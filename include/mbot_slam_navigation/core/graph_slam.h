@@ -313,6 +313,10 @@ class GraphSlam : public SlamBackend {
   static constexpr double kResumeWindow = 0.5;   ///< [m] +- x, y around a given start pose
   static constexpr double kResumeAngle = 0.35;   ///< [rad] +- yaw around it
   static constexpr uint32_t kSessionVersion = 1;
+  /// [m] localization: the local map (saved nodes near the robot, and the last kTemporaryNodes
+  /// scans as temporary nodes) is built again when the robot has moved this far
+  static constexpr double kLocalizeRebuild = 1.0;
+  static constexpr std::size_t kTemporaryNodes = 10;
 
  private:
   struct Node {
@@ -349,7 +353,7 @@ class GraphSlam : public SlamBackend {
   /// processScan in localization mode after the robot was found: tracks the scan only.
   bool localize(const Eigen::Vector3d& odom, const LaserScan& scan, double time_s);
   /// A local map of the saved nodes nearest `pose` (those with their scans, within the match
-  /// reach), in the map frame; null if none (mutex_ held for the node list).
+  /// reach) and the temporary nodes, in the map frame; null if none (mutex_ held).
   std::unique_ptr<LikelihoodGrid> sessionMapNearLocked(const Eigen::Vector3d& pose, Visibility* seen) const;
   /// Whether node n completes a submap (submaps count from the session's start: session_start_).
   bool completesSubmap(int n) const { return n >= session_start_ && (n + 1 - session_start_) % params_.submap_nodes == 0; }
@@ -438,6 +442,8 @@ class GraphSlam : public SlamBackend {
   std::string resume_failure_;
   std::unique_ptr<LikelihoodGrid> session_grid_;  // the whole saved map, for global matching
   Eigen::Vector3d localized_at_ = Eigen::Vector3d::Zero();  // where the localization's local map was built
+  // localization's temporary nodes (map frame pose, scan), oldest first
+  std::deque<std::pair<Eigen::Vector3d, std::shared_ptr<const LaserScan>>> temporary_;
 
   double search_window_ = 0.0;  // [m] the tracking window for the next scan (local_search_sigmas)
   double linear_distance_ = 0.0, angular_distance_ = 0.0, last_update_time_ = 0.0, travelled_ = 0.0;
