@@ -482,7 +482,15 @@ bool GraphSlam::localize(const Eigen::Vector3d& odom, const LaserScan& scan, dou
   Eigen::Vector3d predicted;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    predicted = composePose(track_pose_, relativePose(track_odom_, odom));
+    const Eigen::Vector3d step = relativePose(track_odom_, odom);
+    predicted = composePose(track_pose_, step);
+    if (step.head<2>().norm() < kLocalizeStep && std::abs(step.z()) < kLocalizeTurn) {
+      // As amcl's update_min_d and update_min_a: odometry carries the pose over short moves (and
+      // a robot standing still costs nothing); currentPose() composes it.
+      last_odom_ = odom;
+      if (params_.keep_scan_poses) scans_.push_back({time_s, session_start_ - 1, relativePose(local_anchor_, predicted)});
+      return false;
+    }
   }
   std::vector<Eigen::Vector2d> points = matchPoints(scan, params_.matcher.laser_pose, matchReach(), params_.delta);
   if (params_.local_visible_only && !local_seen_.empty()) {

@@ -20,6 +20,7 @@
 // (graph_slam.h); an unknown private parameter gets a warning naming the nearest known one (the
 // tutorial's `base_link` means `base_frame`).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <memory>
@@ -442,12 +443,21 @@ class SlamGmappingNode {
     if (backend_ == "graph") publishMap(stamp);
   }
 
-  // After a scan that tried to join a loaded session: says how it went (an error every 10 s while it
-  // does not match, one line when it does).
-  void reportResume(const mbot::core::GraphSlam& graph, const ros::Time&) {
+  // After a scan that tried to join a loaded session: says how it went (while it does not match,
+  // why: as information at first, the robot may still move to where its view is not repeated; as
+  // a warning after kResumeWarnAfter; one line when it matches).
+  void reportResume(const mbot::core::GraphSlam& graph, const ros::Time& stamp) {
+    resuming_ = graph.resuming();
     if (graph.resuming()) {
-      ROS_ERROR_THROTTLE(10.0, "slam_gmapping: the robot is not found on the session's map %s yet: %s",
-                         loaded_path_.c_str(), graph.resumeFailure().c_str());
+      if (resume_since_.isZero() || stamp < resume_since_) resume_since_ = stamp;
+      const double trying = (stamp - resume_since_).toSec();
+      if (trying < kResumeWarnAfter) {
+        ROS_INFO_THROTTLE(5.0, "slam_gmapping: the robot is not found on the session's map %s yet: %s; trying again "
+                          "every %.1f s", loaded_path_.c_str(), graph.resumeFailure().c_str(), kResumeTryPeriod);
+      } else {
+        ROS_WARN_THROTTLE(10.0, "slam_gmapping: the robot is not found on the session's map %s after %.0f s: %s",
+                          loaded_path_.c_str(), trying, graph.resumeFailure().c_str());
+      }
       return;
     }
     const Eigen::Vector3d p = graph.currentPose();
@@ -484,11 +494,13 @@ class SlamGmappingNode {
     if (!notes.empty()) ROS_WARN("slam_gmapping: session %s: %s", path.c_str(), notes.c_str());
     loaded->resume(at_dock && !start ? std::optional<Eigen::Vector3d>(loaded->firstPose()) : start, localization);
     const int nodes = loaded->updates();
+    const bool resuming = loaded->resuming();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       slam_ = std::move(loaded);
       laser_checked_ = false;
-      last_resume_try_ = ros::Time();
+      last_resume_try_ = resume_since_ = ros::Time();
+      resuming_ = resuming;
       loaded_path_ = path;
       resume_how_ = how;
       last_map_update_ = ros::Time();
@@ -579,7 +591,9 @@ class SlamGmappingNode {
         m = map_to_odom_;
       }
       const ros::Time now = ros::Time::now();
-      if (now.isZero() || now == last_tf_time) {  // no /clock yet, or it has not moved: nothing new
+      // Nothing new without /clock or while it stands still; nothing before the robot is found on a
+      // loaded session's map.
+      if (now.isZero() || now == last_tf_time || resuming_) {
         rate.sleep();
         continue;
       }
@@ -622,7 +636,12 @@ class SlamGmappingNode {
   bool laser_checked_ = true;       // the laser's pose compared with a loaded session's
   std::string loaded_path_, resume_how_;  // the session loaded and how the robot is found on it
   ros::Time last_resume_try_;             // the scan that last tried to join a loaded session
-  static constexpr double kResumeTryPeriod = 0.5;  // [s] of scan time between tries
+  ros::Time resume_since_;                // the first scan that tried
+  // Read by the map -> odom broadcast: until the robot is found on a loaded session's map, no
+  // map -> odom is sent (any would be a guess that move_base and amcl's users would trust).
+  std::atomic<bool> resuming_{false};
+  static constexpr double kResumeTryPeriod = 0.5;   // [s] of scan time between tries
+  static constexpr double kResumeWarnAfter = 10.0;  // [s] of trying before it is a warning
   std::mutex mutex_, map_mutex_;
   // Stamps of map -> odom lately sent by the broadcast loop and by the scan callback (stamp_mutex_).
   static constexpr std::size_t kStampMemory = 256;

@@ -317,6 +317,9 @@ class GraphSlam : public SlamBackend {
   /// scans as temporary nodes) is built again when the robot has moved this far
   static constexpr double kLocalizeRebuild = 1.0;
   static constexpr std::size_t kTemporaryNodes = 10;
+  /// [m], [rad] localization: a scan is matched once odometry moved this far since the last match
+  static constexpr double kLocalizeStep = 0.1;
+  static constexpr double kLocalizeTurn = 0.02;
 
  private:
   struct Node {
