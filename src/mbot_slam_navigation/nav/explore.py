@@ -52,7 +52,7 @@ from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, ColorRGBA
-from std_srvs.srv import Empty
+from std_srvs.srv import Empty, Trigger, TriggerResponse
 from visualization_msgs.msg import Marker, MarkerArray
 
 from mbot_slam_navigation import _core, explore_report
@@ -259,11 +259,34 @@ class Explore:
         self.done_pub = rospy.Publisher('explore/complete', Bool, queue_size=1, latch=True)
         self.done_pub.publish(Bool(False))
         self.move_base = SimpleActionClient('move_base', MoveBaseAction, feedback=False)  # never read here
+        # Pause (m-explore's explore/resume topic, and explore/pause, explore/resume services):
+        # while paused no goal is sent, the current one is cancelled, and the clocks of
+        # max_duration, progress and plateaus stand.
+        self.paused = False
+        self.pause_began = 0.0                       # [s] simulated, when the current pause began
+        self.pause_requested: Optional[bool] = None  # set by the callbacks, taken by the loop
+        self.paused_s = 0.0                          # [s] simulated, in pauses so far
+        self.pause_srv = rospy.Service('explore/pause', Trigger, lambda _: self.request_pause(True))
+        self.resume_srv = rospy.Service('explore/resume', Trigger, lambda _: self.request_pause(False))
+        rospy.Subscriber('explore/resume', Bool, lambda msg: self.request_pause(not msg.data))
         self.mates = {}  # name -> (ExplorerState, wall time received)
         self.team_pub = None
         if team_topic:
             self.team_pub = rospy.Publisher(team_topic, ExplorerState, queue_size=10)
             rospy.Subscriber(team_topic, ExplorerState, self.on_mate, queue_size=20)
+
+    def request_pause(self, pause: bool) -> TriggerResponse:
+        """explore/pause and explore/resume (services), explore/resume (std_msgs/Bool, explore_lite's:
+        false pauses, true resumes). The exploring loop acts on it within a tenth of a second."""
+        was = self.paused if self.pause_requested is None else self.pause_requested
+        self.pause_requested = pause
+        if self.start_time is None:
+            what = 'not exploring yet; it will %s when it starts' % ('wait paused' if pause else 'go on')
+        elif was == pause:
+            what = 'already %s' % ('paused' if pause else 'exploring')
+        else:
+            what = 'pausing: no new goals, the current one cancelled' if pause else 'resuming'
+        return TriggerResponse(success=True, message='explore: ' + what)
 
     def on_mate(self, msg: ExplorerState) -> None:
         if msg.robot != self.robot_name:
@@ -492,8 +515,13 @@ class Explore:
         next_print, empty_cycles, escapes_failed = 0.0, 0, 0
         boxed_since: Optional[float] = None
         while not rospy.is_shutdown():
+            if self.pause_requested is not None and self.pause_requested != self.paused:
+                self.set_paused(self.pause_requested)
+            if self.paused:
+                self.wait_paused()
+                continue
             now = self.elapsed()
-            if self.max_duration > 0 and now >= self.max_duration:
+            if self.max_duration > 0 and now - self.paused_s >= self.max_duration:
                 rospy.logwarn('explore: max_duration %.0f s reached with frontiers left; ending the exploration'
                               % self.max_duration)
                 pose = self.robot_pose()
@@ -617,6 +645,29 @@ class Explore:
             self.wait_cycle()
         return None
 
+    def set_paused(self, pause: bool) -> None:
+        self.paused = pause
+        now = self.elapsed()
+        if pause:
+            self.pause_began = now
+            if self.state.goal is not None:
+                self.move_base.cancel_goal()
+                self.state.goal = None  # chosen anew on resuming: the map may have changed
+            rospy.loginfo('explore: paused at %.0f s: no new goals until explore/resume' % now)
+        else:
+            self.paused_s += now - self.pause_began
+            # the robot stood still on purpose: neither stuck nor on a plateau
+            pose = self.robot_pose()
+            if pose is not None:
+                self.motion.reset(now, pose[:2])
+            self.plateau.pause(now - self.pause_began)
+            rospy.loginfo('explore: resumed at %.0f s after a pause of %.0f s' % (now, now - self.pause_began))
+
+    def wait_paused(self) -> None:
+        """One short wait while paused, the path still recorded."""
+        self.record_path()
+        sim_sleep(0.1)
+
     def frontiers(self, now: float, m: Grid, m_stamp, costmap: Grid, pose, avoid,
                   everything: bool = False) -> Tuple[List[Frontier], int, dict]:
         """(frontiers that may be sent now, best first; how many wait out a blacklisting; the
@@ -643,17 +694,21 @@ class Explore:
 
     def wait_cycle(self) -> None:
         """Until the next planning cycle: 1/planner_frequency, or sooner when move_base finishes the
-        goal (the robot would otherwise stand at a reached goal for up to a whole period)."""
-        self.wait_for_goal(self.period, watch=self.state.goal is not None)
+        goal (the robot would otherwise stand at a reached goal for up to a whole period) or a pause
+        or resume is asked for."""
+        self.wait_for_goal(self.period, watch=self.state.goal is not None, pausable=True)
 
-    def wait_for_goal(self, timeout: float, watch: bool = True) -> bool:
+    def wait_for_goal(self, timeout: float, watch: bool = True, pausable: bool = False) -> bool:
         """Waits up to `timeout` [s, ROS time], recording the path; with `watch`, only until move_base
-        has finished the goal. True if it has (and `watch`)."""
+        has finished the goal, with `pausable` only until a pause or resume is asked for. True if
+        move_base has finished (and `watch`)."""
         start = rospy.Time.now()
         end = start + rospy.Duration(timeout)
         while not rospy.is_shutdown() and start <= rospy.Time.now() < end:
             if watch and self.move_base.simple_state == SimpleGoalState.DONE:
                 return True
+            if pausable and self.pause_requested is not None and self.pause_requested != self.paused:
+                return False  # paused or resumed: the exploring loop acts on it now
             self.record_path()
             sim_sleep(min(0.25, timeout))
         return watch and self.move_base.simple_state == SimpleGoalState.DONE
@@ -774,6 +829,7 @@ class Explore:
             'goals_sent': self.state.goals_chosen,
             'goals_failed': self.goals_failed(),
             'collisions': self.collisions,
+            'paused_s': round(self.paused_s, 1),
             'cpu_s_per_s_exploring': round(cpu_exploring / max(t_explored, 1e-6), 4),
             'longest_plateau_s': round(self.plateau.longest, 1),
             'longest_plateau_at_s': round(self.plateau.longest_at, 1),

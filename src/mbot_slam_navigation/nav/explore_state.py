@@ -314,6 +314,11 @@ class Plateau:
     longest_at: float = 0.0     # [s] when that stretch began
     _mark: Optional[Tuple[float, float]] = None  # (time, known area) at the last growth
 
+    def pause(self, seconds: float) -> None:
+        """The exploration was paused for `seconds`: not a stretch without progress."""
+        if self._mark is not None:
+            self._mark = (self._mark[0] + seconds, self._mark[1])
+
     def update(self, now: float, known_m2: float, frontiers_left: bool) -> None:
         if not frontiers_left:
             self._mark = None
