@@ -16,7 +16,7 @@ import numpy as np
 from mbot_slam_navigation.home_rooms import room_coverage
 from mbot_slam_navigation.map_stats import free_at
 from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupancy_to_image, save_map
-from mbot_slam_navigation.nav.frontiers import Grid
+from mbot_slam_navigation.nav.frontiers import Grid, inside_polygon
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
 from mbot_slam_navigation.sim.sdf_world import World
 from mbot_slam_navigation.transforms import compose2d
@@ -72,9 +72,13 @@ def reachable_free_space(world: World, start: Tuple[float, float], robot_radius:
 
 
 def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robot_radius: float,
-                         wall_tolerance: float = 0.1, truth=None) -> Dict[str, float]:
+                         wall_tolerance: float = 0.1, truth=None, boundary=None) -> Dict[str, float]:
+    """Coverage of the reachable free space and the walls' distance to the world's surfaces; with
+    `boundary` ((N, 2) [m], world frame), the reachable space inside it only."""
     truth = truth if truth is not None else rasterize(world, m.resolution)
     mask, origin = reachable_free_space(world, start, robot_radius, m.resolution, truth)
+    if boundary is not None:
+        mask = mask & inside_polygon(Grid(mask, m.resolution, origin), boundary)
     rows, cols = np.nonzero(mask)
     x = origin[0] + (cols + 0.5) * m.resolution
     y = origin[1] + (rows + 0.5) * m.resolution
@@ -187,17 +191,19 @@ def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 40
 
 
 def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World], start: Tuple[float, float],
-                 robot_radius: float, rooms, world_from_map: Pose2D = (0.0, 0.0, 0.0)) -> Dict:
+                 robot_radius: float, rooms, world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None) -> Dict:
     """`figures` with the map's own (explored area; against the world when given: coverage, walls,
-    each room's share), after writing the map (map.pgm, map.yaml) into report_dir. `start` is in the
-    map frame."""
+    each room's share), after writing the map (map.pgm, map.yaml) into report_dir. `start` and
+    `boundary` (the explored area's polygon, coverage counted inside it) are in the map frame."""
     os.makedirs(report_dir, exist_ok=True)
     figures['explored_area_m2'] = round(known_area(m), 2)
     if world is not None:
         seen = map_in_world(m, world_from_map)
         start_world = compose2d(world_from_map, (start[0], start[1], 0.0))[:2]
         truth = rasterize(world, m.resolution)  # once for all the figures below
-        figures.update(ground_truth_figures(seen, world, start_world, robot_radius, truth=truth))
+        bounds = None if boundary is None else np.array([compose2d(world_from_map, (x, y, 0.0))[:2]
+                                                         for x, y in boundary])
+        figures.update(ground_truth_figures(seen, world, start_world, robot_radius, truth=truth, boundary=bounds))
         if rooms:
             figures['room_coverage'] = {k: round(v, 3) for k, v in
                                         room_coverage(seen, truth[0], truth[1], m.resolution, rooms=rooms).items()}
@@ -208,12 +214,13 @@ def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World]
 def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
                  curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
                  start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=(),
-                 world_from_map: Pose2D = (0.0, 0.0, 0.0)) -> Dict:
+                 world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None) -> Dict:
     """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
     With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free.
-    `world` holds the shapes that count (World.blocking for the robot's heights); the map, path and
-    start are in the map frame, whose pose in the world is `world_from_map`."""
-    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms, world_from_map)
+    `world` holds the shapes that count (World.blocking for the robot's heights); the map, path,
+    start and `boundary` (an explored area's polygon: coverage counts inside it) are in the map
+    frame, whose pose in the world is `world_from_map`."""
+    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms, world_from_map, boundary)
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)

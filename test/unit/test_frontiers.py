@@ -599,3 +599,29 @@ def test_a_map_allocated_larger_than_what_is_known_gives_the_same_frontiers():
     assert [(f.goal, f.cost, f.unknown_m2) for f in a] == [(pytest.approx(f.goal), pytest.approx(f.cost),
                                                             pytest.approx(f.unknown_m2)) for f in b]
     assert stats['costmap'].data.shape[0] < big.data.shape[0] and stats['costmap'].data.shape[1] < big.data.shape[1]
+
+
+def test_a_boundary_leaves_the_frontiers_outside_it_out_and_counts_them():
+    m = _hall_with_doors()
+    c = costmap_of(m)
+    everything = rank_frontiers(m, c, (3.0, 3.0), min_frontier_size=0.5)
+    # the western half of the hall (x < 12 m), walls included
+    west = np.array([[1.0, 1.0], [12.0, 1.0], [12.0, 15.0], [1.0, 15.0]])
+    stats = {}
+    inside = rank_frontiers(m, c, (3.0, 3.0), min_frontier_size=0.5, boundary=west, stats=stats)
+    assert inside and all(f.cells[:, 0].max() < 12.0 for f in inside)
+    assert len(inside) < len(everything)
+    left_out = sum(f.size_m for f in everything if f.cells[:, 0].min() > 12.0)
+    assert stats['outside_m'] == pytest.approx(left_out, abs=0.2)
+    # nothing inside: nothing to explore there
+    assert rank_frontiers(m, c, (3.0, 3.0), boundary=np.array([[3.0, 3.0], [4.0, 3.0], [4.0, 4.0]])) == []
+
+
+def test_the_boundary_parameter_is_checked_by_name():
+    from mbot_slam_navigation.nav.explore import polygon_of
+    from mbot_slam_navigation.nav.params import ParamError
+    assert polygon_of([], '/explore/boundary') is None
+    assert polygon_of([[0, 0], [1, 0], [1, 1]], '/explore/boundary').shape == (3, 2)
+    for bad in ([[0, 0], [1, 0]], [[0, 0], [1], [1, 1]], [[0, 0], [1, 'a'], [1, 1]], 'square'):
+        with pytest.raises(ParamError, match='/explore/boundary must be a list of at least 3'):
+            polygon_of(bad, '/explore/boundary')

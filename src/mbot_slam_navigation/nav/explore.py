@@ -47,7 +47,7 @@ from rospy.numpy_msg import numpy_msg
 from actionlib import SimpleGoalState
 import tf2_ros
 from actionlib_msgs.msg import GoalStatus
-from geometry_msgs.msg import Point, Twist, Vector3
+from geometry_msgs.msg import Point, PolygonStamped, Twist, Vector3
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import LaserScan
@@ -67,7 +67,7 @@ from mbot_slam_navigation.nav.frontiers import (GAIN_SCALE, MIN_FRONTIER_SIZE, P
                                                 Grid, passable, rank_frontiers)
 from mbot_slam_navigation.nav.team import Teammate, share_out, yields_goal
 from mbot_slam_navigation.nav.tour import tour_order
-from mbot_slam_navigation.nav.params import ParamReader
+from mbot_slam_navigation.nav.params import ParamError, ParamReader
 from mbot_slam_navigation.ros_msgs import pose_msg
 from mbot_slam_navigation.sim.ground_truth import load_truth
 from mbot_slam_navigation.topic_watch import WatchedSubscriber
@@ -183,7 +183,25 @@ def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> Simple
     c.robot_name = r.string('robot_name', default_robot_name, "ours: this robot's name in the team (default: namespace)")
     c.claim_radius = r.number('claim_radius', 2.0, "[m] ours: a frontier whose goal is this near a teammate's goal "
                               "is left to it", minimum=0.0)
+    boundary = r.raw('boundary', [], "[m] ours: [[x, y], ...] in global_frame: explore only inside this polygon "
+                     "(frontier_exploration's; also the explore/boundary topic); []: everywhere", 'list')
+    c.boundary = polygon_of(boundary, r.where('boundary'))
     return c
+
+
+def polygon_of(points, where: str) -> Optional[np.ndarray]:
+    """(N, 2) [m] from [[x, y], ...], None for []; ParamError naming `where` for anything else."""
+    if isinstance(points, (list, tuple)) and not points:
+        return None
+    if not isinstance(points, (list, tuple)):
+        raise ParamError('%s must be a list of at least 3 [x, y] points, got %r' % (where, points))
+    try:
+        polygon = np.array([[float(p[0]), float(p[1])] for p in points if len(p) == 2], float)
+    except (TypeError, ValueError, IndexError):
+        polygon = np.zeros((0, 2))
+    if len(polygon) != len(points) or len(polygon) < 3 or not np.all(np.isfinite(polygon)):
+        raise ParamError('%s must be a list of at least 3 [x, y] points, got %r' % (where, points))
+    return polygon
 
 
 class Explore:
@@ -269,11 +287,33 @@ class Explore:
         self.pause_srv = rospy.Service('explore/pause', Trigger, lambda _: self.request_pause(True))
         self.resume_srv = rospy.Service('explore/resume', Trigger, lambda _: self.request_pause(False))
         rospy.Subscriber('explore/resume', Bool, lambda msg: self.request_pause(not msg.data))
+        # The area to explore (frontier_exploration's polygon), map frame; None: everywhere.
+        self.boundary: Optional[np.ndarray] = c.boundary
+        self.outside_m = 0.0  # [m] of frontier left out by the boundary at the last cycle
+        rospy.Subscriber('explore/boundary', PolygonStamped, self.on_boundary, queue_size=1)
         self.mates = {}  # name -> (ExplorerState, wall time received)
         self.team_pub = None
         if team_topic:
             self.team_pub = rospy.Publisher(team_topic, ExplorerState, queue_size=10)
             rospy.Subscriber(team_topic, ExplorerState, self.on_mate, queue_size=20)
+
+    def on_boundary(self, msg: PolygonStamped) -> None:
+        """explore/boundary: the area to explore from now on; an empty polygon: everywhere."""
+        frame = msg.header.frame_id.lstrip('/')
+        if not msg.polygon.points:
+            self.boundary = None
+            rospy.loginfo('explore: boundary cleared: exploring everywhere')
+            return
+        if frame and frame != self.global_frame:
+            rospy.logwarn('explore: a boundary on explore/boundary in frame "%s" ignored: it must be in %s'
+                          % (frame, self.global_frame))
+            return
+        if len(msg.polygon.points) < 3:
+            rospy.logwarn('explore: a boundary on explore/boundary with %d points ignored: a polygon needs 3'
+                          % len(msg.polygon.points))
+            return
+        self.boundary = np.array([[p.x, p.y] for p in msg.polygon.points], float)
+        rospy.loginfo('explore: exploring inside a boundary of %d points from explore/boundary' % len(self.boundary))
 
     def request_pause(self, pause: bool) -> TriggerResponse:
         """explore/pause and explore/resume (services), explore/resume (std_msgs/Bool, explore_lite's:
@@ -435,6 +475,14 @@ class Explore:
             goal.scale.x = goal.scale.y = goal.scale.z = 0.15
             goal.color = colour
             out.markers += [cells, goal]
+        if self.boundary is not None:
+            line = Marker(type=Marker.LINE_STRIP, action=Marker.ADD, ns='boundary', id=0)
+            line.header.frame_id, line.header.stamp = self.global_frame, now
+            line.scale.x = 0.05
+            line.color = ColorRGBA(1.0, 0.5, 0.0, 1.0)
+            line.pose.orientation.w = 1.0
+            line.points = [Point(float(x), float(y), 0.0) for x, y in list(self.boundary) + [self.boundary[0]]]
+            out.markers.append(line)
         if len(unranked):
             rest = Marker(type=Marker.POINTS, action=Marker.ADD, ns='frontiers_unranked', id=0)
             rest.header.frame_id, rest.header.stamp = self.global_frame, now
@@ -687,7 +735,8 @@ class Explore:
                                 avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
                                 keep_goal=self.state.goal.goal if self.state.goal is not None else None,
                                 min_unknown_beside=self.min_unknown_beside, gain_size_max=self.gain_size_max,
-                                enough=enough, eligible=lambda f: judge(f) is ELIGIBLE)
+                                enough=enough, eligible=lambda f: judge(f) is ELIGIBLE, boundary=self.boundary)
+        self.outside_m = stats.get('outside_m', 0.0)
         frontiers, waiting, given_up = self.state.screen(now, ranked, map_time)
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats
@@ -830,6 +879,9 @@ class Explore:
             'goals_failed': self.goals_failed(),
             'collisions': self.collisions,
             'paused_s': round(self.paused_s, 1),
+            'boundary': None if self.boundary is None else [[round(float(x), 3), round(float(y), 3)]
+                                                            for x, y in self.boundary],
+            'frontier_outside_boundary_m': round(self.outside_m, 2),
             'cpu_s_per_s_exploring': round(cpu_exploring / max(t_explored, 1e-6), 4),
             'longest_plateau_s': round(self.plateau.longest, 1),
             'longest_plateau_at_s': round(self.plateau.longest_at, 1),
@@ -848,7 +900,7 @@ class Explore:
                         rospy.logwarn('explore: no coverage per room: %s' % e)
             figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
                                                   self.curve, figures, world, start[:2], self.robot_radius, rooms,
-                                                  self.world_from_map)
+                                                  self.world_from_map, self.boundary)
             print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
                   % os.path.abspath(self.report_dir), flush=True)
         for k, v in figures.items():

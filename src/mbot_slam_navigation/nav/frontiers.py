@@ -125,13 +125,28 @@ def _longest_piece(mask: np.ndarray) -> float:
     return float(np.max(np.hypot(stats[1:, 2], stats[1:, 3]))) if n > 1 else 0.0
 
 
-def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells: int = 1) -> List[np.ndarray]:
+def inside_polygon(m: Grid, polygon) -> np.ndarray:
+    """Bool mask of the cells of m whose centres lie inside `polygon` ((N, 2) [m], map frame)."""
+    pts = (np.asarray(polygon, float) - np.asarray(m.origin)) / m.resolution - 0.5
+    mask = np.zeros(m.data.shape, np.uint8)
+    # OpenCV draws at integer vertices: 4 bits of sub-cell precision
+    cv2.fillPoly(mask, [np.rint(pts * 16).astype(np.int32)], 1, lineType=cv2.LINE_8, shift=4)
+    return mask > 0
+
+
+def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells: int = 1,
+                     inside: Optional[np.ndarray] = None, stats: Optional[dict] = None) -> List[np.ndarray]:
     """The frontiers of at least min_cells cells, largest first (a large map has thousands of
-    one- and two-cell fragments: they are counted, not listed)."""
+    one- and two-cell fragments: they are counted, not listed). With `inside` (a mask of m), only
+    its cells count; stats['outside_m'] gets the frontier [m] left out."""
     data = m.data
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
+    if inside is not None:
+        if stats is not None:
+            stats['outside_m'] = float(np.count_nonzero(frontier & ~inside)) * m.resolution
+        frontier &= inside.astype(np.uint8)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(frontier, connectivity=8)
     # one pass over the labelled cells, split by label (not one scan of the grid per group)
     rows, cols = np.nonzero(labels)
@@ -216,7 +231,8 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                    unreachable: Optional[List[GivenUp]] = None,
                    keep_goal: Optional[Tuple[float, float]] = None,
                    min_unknown_beside: float = 0.0, gain_size_max: float = 0.0, enough: int = 0,
-                   eligible: Optional[Callable[[Frontier], bool]] = None) -> List[Frontier]:
+                   eligible: Optional[Callable[[Frontier], bool]] = None,
+                   boundary: Optional[np.ndarray] = None) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
@@ -234,6 +250,9 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     last frontier). A frontier with less than min_unknown_beside [m^2] of unknown space within
     GAIN_RADIUS of its cells (Frontier.unknown_m2; beyond the grid's edge counts as unknown) goes to
     `unreachable` too: it is not worth a trip.
+
+    With `boundary` ((N, 2) [m], map frame: frontier_exploration's polygon) only the frontier cells
+    inside it count; stats['outside_m'] says how much frontier it left out.
 
     A frontier's size counts in its cost up to gain_size_max [m] (0: no cap). Uncapped, the edge of
     the laser's view down a corridor (60 m of frontier in the office, seen from its lobby) outweighs
@@ -283,8 +302,10 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     unknown = unknown_space(m, occupied_min, min_unknown_area)
     # beyond the grid's edge is unknown too (the SLAM map grows as the robot sees more)
     unknown_beyond = cv2.copyMakeBorder(unknown, g_reach, g_reach, g_reach, g_reach, cv2.BORDER_CONSTANT, value=1)
+    inside = inside_polygon(m, boundary) if boundary is not None else None
     groups = [g for g in _frontier_groups(m, unknown, occupied_min,
-                                          max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9))))
+                                          max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9))),
+                                          inside, stats)
               if len(g) * m.resolution >= min_frontier_size]
 
     def evaluate(g: np.ndarray) -> Optional[Frontier]:
