@@ -8,9 +8,11 @@
 2. The finished session saved again, slam_gmapping started in localization mode on it (the robot
    back at its dock, where the session began) stands in for amcl: move_base reaches the tutorial's
    nine points, checked against the simulator's ground truth.
+3. On it, a patrol of the nine points in order (launch/patrol.launch), two rounds: 18 of 18.
 """
 import math
 import os
+import re
 import subprocess
 import time
 import unittest
@@ -145,6 +147,18 @@ class SlamSessionTest(unittest.TestCase):
         self.restart('_mode:=localization', '_map_start_at_dock:=true')
         self.wait('the robot localized at its dock', lambda: self.pose_error() < 0.1, 120.0)
         reach_tutorial_points(self, lambda: self.truth.pose.pose.position, GOAL_TIMEOUT, XY_TOL)
+        self.assertLess(self.pose_error(), 0.1)
+        self.assertEqual(self.contacts, [])
+
+    def test_3_a_patrol_of_the_nine_points_twice_reaches_all_eighteen(self):
+        patrol = subprocess.run(['roslaunch', 'mbot_slam_navigation', 'patrol.launch', 'rounds:=2', 'rest_time:=0.5'],
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=900)
+        out = patrol.stdout
+        order = re.findall(r'Going to: (p\d)', out)
+        self.assertEqual(order, ['p%d' % k for k in range(1, 10)] * 2, out[-3000:])
+        summary = re.search(r'summary: (\d+) goals, (\d+) succeeded', out)
+        self.assertIsNotNone(summary, out[-3000:])
+        self.assertEqual((int(summary.group(1)), int(summary.group(2))), (18, 18), out[-3000:])
         self.assertLess(self.pose_error(), 0.1)
         self.assertEqual(self.contacts, [])
 

@@ -148,3 +148,21 @@ def test_move_launch_has_the_tutorials_move_base_and_no_competing_amcl():
     assert mb['TrajectoryPlannerROS/max_vel_x'] == 0.3 and mb['global_costmap/static_map'] is True
     amcl = node_params(path, '/amcl', ['amcl:=true'])
     assert amcl['tf_broadcast'] is False and amcl['use_map_topic'] is True and amcl['min_particles'] == 500
+
+
+def test_the_patrol_example_is_the_tutorials_table_and_the_order_is_checked():
+    """config/home_patrol.yaml (launch/patrol.launch's points) holds the tutorial's nine points, in order."""
+    from mbot_slam_navigation.nav.params import ParamError, ParamReader
+    from mbot_slam_navigation.nav.random_navigation import read_parameters
+    here = os.path.dirname(os.path.abspath(__file__))
+    patrol = load_locations(os.path.join(here, '..', '..', 'config', 'home_patrol.yaml'))
+    table = tutorial_locations()
+    assert [p.name for p in patrol] == [t.name for t in table]
+    for p, t in zip(patrol, table):
+        assert (p.x, p.y, p.room) == (t.x, t.y, t.room)
+        assert abs(math.remainder(quaternion_to_yaw(*p.orientation) - quaternion_to_yaw(*t.orientation), 2 * math.pi)) < 1e-3
+    launch = node_params(os.path.join(here, '..', '..', 'launch', 'patrol.launch'), '/patrol')
+    assert launch['order'] == 'sequence'
+    assert read_parameters(ParamReader({'order': 'sequence', 'rounds': 2}, '/patrol', print))['rounds'] == 2
+    with pytest.raises(ParamError, match="/patrol/order must be 'random' or 'sequence'"):
+        read_parameters(ParamReader({'order': 'shuffled'}, '/patrol', print))

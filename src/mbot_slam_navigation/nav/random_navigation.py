@@ -17,7 +17,8 @@ goal, the log lines, a shutdown that cancels the goal and stops the robot), with
 Parameters (private): rest_time (2 s), locations_file ('' = the tutorial's table; see
 config/wall_locations.yaml for the format), max_goals (0 = forever), max_duration (0 = forever, s
 of ROS time), goal_timeout (300 s), seed (-1 = random), frame_id ('map'), base_frame
-('base_footprint'), server_timeout (60 s of wall time). With a limit it prints a summary and exits 0.
+('base_footprint'), server_timeout (60 s of wall time), order (random, or sequence: a patrol in the
+file's order) and rounds (0 = forever). With a limit it prints a summary and exits 0.
 
 Beyond the tutorial: move_base killed mid-goal (and respawned) is noticed, waited for and the goal
 sent again (pursue()), so a soak's count goes on instead of waiting out goal_timeout; a goal that
@@ -203,7 +204,7 @@ class Tally:
 
 def read_parameters(r: ParamReader) -> dict:
     """The node's parameters (the tutorial's script has none; all are ours), checked."""
-    return {
+    c = {
         'rest_time': r.number('rest_time', 2.0, '[s] pause at each goal, as the tutorial', minimum=0.0),
         'max_goals': r.integer('max_goals', 0, 'stop after this many goals (0: never, as the tutorial)', minimum=0),
         'max_duration': r.number('max_duration', 0.0, '[s] stop after this much time (0: never)', minimum=0.0),
@@ -216,7 +217,13 @@ def read_parameters(r: ParamReader) -> dict:
         'seed': r.integer('seed', -1, "the random order's seed (-1: a different order each run)"),
         'locations_file': r.string('locations_file', '',
                                    "a YAML of named poses ('': the tutorial's nine places in the home)"),
+        'order': r.string('order', 'random', "random (the tutorial's: each round in a new order) or sequence (a "
+                          "patrol: the file's order, round after round)"),
+        'rounds': r.integer('rounds', 0, 'stop after this many rounds through every point (0: never)', minimum=0),
     }
+    if c['order'] not in ('random', 'sequence'):
+        raise ParamError("parameter %s must be 'random' or 'sequence', got '%s'" % (r.where('order'), c['order']))
+    return c
 
 
 class RandomNavigation:
@@ -230,6 +237,8 @@ class RandomNavigation:
         self.goal_timeout, self.server_timeout = c['goal_timeout'], c['server_timeout']
         self.frame_id, self.base_frame = c['frame_id'], c['base_frame']
         seed, locations_file = c['seed'], c['locations_file']
+        self.order, self.rounds = c['order'], c['rounds']
+        self.rounds_done = 0
         self.locations = load_locations(os.path.expanduser(locations_file)) if locations_file else tutorial_locations()
         for loc in self.locations:
             if loc.note:
@@ -270,6 +279,8 @@ class RandomNavigation:
     def limit_reached(self) -> bool:
         if self.max_goals and self.tally.goals >= self.max_goals:
             return True
+        if self.rounds and self.rounds_done >= self.rounds:
+            return True
         return bool(self.max_duration) and self.running_time() >= self.max_duration
 
     def running_time(self) -> float:
@@ -299,8 +310,9 @@ class RandomNavigation:
         self.start_time = rospy.Time.now()
         sequence, i, last = [], len(names), ''
         while not rospy.is_shutdown() and not self.limit_reached():
-            if i == len(names):  # all visited: a new random order
-                sequence, i = next_round(self.rng, names, last), 0
+            if i == len(names):  # all visited: a new round, in a new random order or the file's
+                sequence, i = (next_round(self.rng, names, last) if self.order == 'random' else list(names)), 0
+                rospy.loginfo('Round %d%s', self.rounds_done + 1, ' of %d' % self.rounds if self.rounds else '')
             loc = by_name[sequence[i]]
             if self.new_pose is not None:  # a 2D Pose Estimate since the last goal
                 rospy.loginfo('Updating current pose.')
@@ -320,7 +332,13 @@ class RandomNavigation:
             else:
                 rospy.loginfo('Goal failed with error code: ' + state)
             self.goal_active = False
+            if state not in ('SUCCEEDED', 'TIMED_OUT'):
+                # skipped with the reason (move_base's), the patrol goes on to the next point
+                rospy.logwarn('random_navigation: %s skipped: %s', loc.name,
+                              self.move_base.get_goal_status_text() or state)
             self.tally.record(loc.name, state, distance)
+            if i == len(names):
+                self.rounds_done += 1
             # Measured from where the robot was meant to be, as the tutorial does.
             position, last = (loc.x, loc.y), loc.name
             rospy.loginfo(self.tally.success_line())
