@@ -147,12 +147,12 @@ def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells:
         if stats is not None:
             stats['outside_m'] = float(np.count_nonzero(frontier & ~inside)) * m.resolution
         frontier &= inside.astype(np.uint8)
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(frontier, connectivity=8)
+    n, labels, areas, _ = cv2.connectedComponentsWithStats(frontier, connectivity=8)
     # one pass over the labelled cells, split by label (not one scan of the grid per group)
     rows, cols = np.nonzero(labels)
     lab = labels[rows, cols]
     if min_cells > 1:
-        big = stats[lab, cv2.CC_STAT_AREA] >= min_cells
+        big = areas[lab, cv2.CC_STAT_AREA] >= min_cells
         rows, cols, lab = rows[big], cols[big], lab[big]
     order = np.argsort(lab, kind='stable')
     rows, cols, lab = rows[order], cols[order], lab[order]
