@@ -426,7 +426,7 @@ bool GraphSlam::resumeWith(const Eigen::Vector3d& odom, const LaserScan& scan, d
                                                    &best.pose, 0.5, 0.2);
     if (second.found) {
       std::ostringstream why;
-      why << "the scan matches the saved map equally well at (" << best.pose.x() << ", " << best.pose.y() << ", "
+      why << "the scan matches the saved map nearly as well at (" << best.pose.x() << ", " << best.pose.y() << ", "
           << best.pose.z() << ") and at (" << second.pose.x() << ", " << second.pose.y() << ", " << second.pose.z()
           << "): give the start pose (~map_start_pose or ~map_start_at_dock), or move the robot where the view "
           << "is not repeated";
