@@ -35,6 +35,7 @@
 #include <pthread.h>
 #include <unistd.h>
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/GetMap.h>
 #include <nav_msgs/MapMetaData.h>
@@ -98,6 +99,9 @@ class SlamGmappingNode {
       loadSession(session_file_, start, map_start_at_dock_, mode_ == "localization", how);
     }
     scan_sub_ = nh_.subscribe("scan", scan_queue_size_, &SlamGmappingNode::onScan, this);
+    // rviz's 2D Pose Estimate, as amcl and slam_toolbox's localization take it: where the robot is on
+    // a loaded session's map (searched around it as ~map_start_pose is).
+    initial_pose_sub_ = nh_.subscribe("initialpose", 1, &SlamGmappingNode::onInitialPose, this);
     if (transform_publish_period_ > 0.0) {
       tf_thread_ = std::thread([this] { publishTransformLoop(); });
       pthread_setname_np(tf_thread_.native_handle(), "slam_tf");  // for top -H and /proc
@@ -510,6 +514,31 @@ class SlamGmappingNode {
     return true;
   }
 
+  void onInitialPose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg) {
+    const std::string frame = msg->header.frame_id.empty() || msg->header.frame_id[0] != '/'
+                                  ? msg->header.frame_id : msg->header.frame_id.substr(1);
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto* graph = dynamic_cast<mbot::core::GraphSlam*>(slam_.get());
+    if (!graph || loaded_path_.empty() || !graph->localizing()) {
+      ROS_WARN("slam_gmapping: a pose on %s ignored: it places the robot on a session's map in mode localization "
+               "(~mode, or ~deserialize_map with LOCALIZE_AT_POSE); %s", initial_pose_sub_.getTopic().c_str(),
+               graph && !loaded_path_.empty() ? "this node is mapping" : "no session is loaded");
+      return;
+    }
+    if (!frame.empty() && frame != map_frame_) {
+      ROS_WARN("slam_gmapping: a pose on %s in frame '%s' ignored: it must be in %s", initial_pose_sub_.getTopic().c_str(),
+               frame.c_str(), map_frame_.c_str());
+      return;
+    }
+    const Eigen::Vector3d pose(msg->pose.pose.position.x, msg->pose.pose.position.y, tf2::getYaw(msg->pose.pose.orientation));
+    graph->resume(pose, true);
+    resuming_ = true;
+    last_resume_try_ = resume_since_ = ros::Time();
+    resume_how_ = "near the pose given on " + initial_pose_sub_.getTopic();
+    ROS_INFO("slam_gmapping: finding the robot on the session's map near (%.2f, %.2f, %.2f rad), given on %s", pose.x(),
+             pose.y(), pose.z(), initial_pose_sub_.getTopic().c_str());
+  }
+
   bool onSerialize(mbot_slam_navigation::SerializePoseGraph::Request& req,
                    mbot_slam_navigation::SerializePoseGraph::Response& res) {
     res.result = mbot_slam_navigation::SerializePoseGraph::Response::RESULT_FAILED_TO_WRITE_FILE;
@@ -627,7 +656,7 @@ class SlamGmappingNode {
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_;
-  ros::Subscriber scan_sub_;
+  ros::Subscriber scan_sub_, initial_pose_sub_;
   ros::ServiceServer map_srv_, serialize_srv_, deserialize_srv_;
   // Sessions (slam_config.h).
   std::string session_file_, mode_, save_session_on_exit_;

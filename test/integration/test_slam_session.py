@@ -9,6 +9,7 @@
    back at its dock, where the session began) stands in for amcl: move_base reaches the tutorial's
    nine points, checked against the simulator's ground truth.
 3. On it, a patrol of the nine points in order (launch/patrol.launch), two rounds: 18 of 18.
+4. A 2D Pose Estimate (initialpose) 0.3 m off places the robot again, found within 0.1 m.
 """
 import math
 import os
@@ -21,6 +22,7 @@ import numpy as np
 import rosnode
 import rospy
 import rostest
+from geometry_msgs.msg import PoseWithCovarianceStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from tf2_ros import Buffer, TransformListener
 
@@ -86,12 +88,14 @@ class SlamSessionTest(unittest.TestCase):
                 self.fail('%s: not within %.0f s (wall)' % (what, timeout))
             time.sleep(0.2)
 
-    def pose_error(self):
+    def pose_error(self, since=0.0):
         """[m] map -> base_footprint against the simulator's truth (the home's map frame is its
-        world frame: the robot starts at the origin)."""
+        world frame: the robot starts at the origin); inf when tf has none stamped since `since` [s]."""
         try:
             t = self.tf.lookup_transform('map', 'base_footprint', rospy.Time(0), rospy.Duration(1.0))
         except Exception:
+            return math.inf
+        if t.header.stamp.to_sec() < since:
             return math.inf
         p = self.truth.pose.pose.position
         return math.hypot(t.transform.translation.x - p.x, t.transform.translation.y - p.y)
@@ -149,6 +153,30 @@ class SlamSessionTest(unittest.TestCase):
         reach_tutorial_points(self, lambda: self.truth.pose.pose.position, GOAL_TIMEOUT, XY_TOL)
         self.assertLess(self.pose_error(), 0.1)
         self.assertEqual(self.contacts, [])
+
+    def test_4_a_2d_pose_estimate_places_the_robot_again(self):
+        """rviz's 2D Pose Estimate (initialpose) while localizing. Given 3 m off, where the scans do
+        not match, the node stops sending map -> odom (it no longer knows where the robot is); given
+        0.3 m and 0.15 rad off the truth, the robot is found there and map -> odom comes back within
+        0.1 m of the truth."""
+        pub = rospy.Publisher('/initialpose', PoseWithCovarianceStamped, queue_size=1, latch=True)
+        time.sleep(1.0)  # the subscription connected
+
+        def estimate(dx, dy, dyaw):
+            p, q = self.truth.pose.pose.position, self.truth.pose.pose.orientation
+            yaw = 2.0 * math.atan2(q.z, q.w) + dyaw
+            msg = PoseWithCovarianceStamped()
+            msg.header.frame_id, msg.header.stamp = 'map', rospy.Time.now()
+            msg.pose.pose.position.x, msg.pose.pose.position.y = p.x + dx, p.y + dy
+            msg.pose.pose.orientation.z, msg.pose.pose.orientation.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+            pub.publish(msg)
+            return rospy.get_time()
+
+        given = estimate(3.0, 0.0, 0.0)
+        time.sleep(3.0)  # wall: 10-30 s simulated
+        self.assertEqual(self.pose_error(since=given + 1.0), math.inf, 'map -> odom still sent for a robot not found')
+        given = estimate(0.3, -0.1, 0.15)
+        self.wait('the robot placed again', lambda: self.pose_error(since=given) < 0.1, 60.0)
 
     def test_3_a_patrol_of_the_nine_points_twice_reaches_all_eighteen(self):
         patrol = subprocess.run(['roslaunch', 'mbot_slam_navigation', 'patrol.launch', 'rounds:=2', 'rest_time:=0.5'],
