@@ -237,7 +237,10 @@ def main(argv=None):
     if args.session_in and slam.resuming():
         ap.exit(3, 'slam_offline: no scan joined the session %s: %s\n' % (args.session_in, slam.resume_failure()))
     if args.session_out:
-        print('slam_offline: session written to %s' % slam.save_session(args.session_out))
+        try:
+            print('slam_offline: session written to %s' % slam.save_session(args.session_out))
+        except RuntimeError as e:  # the path and why it cannot be written
+            ap.exit(2, 'slam_offline: the session was not written: %s\n' % e)
     out = args.out or os.path.basename(args.log).split('.')[0]
     if args.session_in and not args.localize:
         scans = before + scans  # the whole trajectory, the session's scans too, as the graph holds it now
