@@ -166,6 +166,17 @@ void bindNavigation(py::module& m) {
       .def_readonly("inflation_radius", &InflationLayerConfig::inflation_radius)
       .def_readonly("cost_scaling_factor", &InflationLayerConfig::cost_scaling_factor)
       .def_readonly("inflate_unknown", &InflationLayerConfig::inflate_unknown);
+  py::class_<FilterConfig>(m, "FilterConfig")
+      .def_readonly("name", &FilterConfig::name)
+      .def_readonly("type", &FilterConfig::type)
+      .def_property_readonly("kind", [](const FilterConfig& f) { return f.kind == FilterConfig::Kind::kSpeed ? "speed" : "keepout"; })
+      .def_readonly("mask_topic", &FilterConfig::mask_topic)
+      .def_property_readonly("zones", [](const FilterConfig& f) {
+        py::list out;
+        for (const auto& z : f.zones) out.append(py::make_tuple(z.name, z.points));
+        return out;
+      })
+      .def_readonly("error", &FilterConfig::error);
   py::class_<CostmapConfig>(m, "CostmapConfig")
       .def_readonly("name", &CostmapConfig::name)
       .def_readonly("global_frame", &CostmapConfig::global_frame)
@@ -181,7 +192,8 @@ void bindNavigation(py::module& m) {
       .def_readonly("layers", &CostmapConfig::layers)
       .def_readonly("static", &CostmapConfig::static_layer)
       .def_readonly("obstacle", &CostmapConfig::obstacle_layer)
-      .def_readonly("inflation", &CostmapConfig::inflation_layer);
+      .def_readonly("inflation", &CostmapConfig::inflation_layer)
+      .def_readonly("filters", &CostmapConfig::filters);
   m.def("read_costmap_config", [](const std::string& name, py::object values, py::object warn, const std::string& ns_prefix) {
     return readCostmapConfig(name, toParam(values), warnOf(warn), ns_prefix);
   }, py::arg("name"), py::arg("values"), py::arg("warn"), py::arg("ns_prefix") = "");
@@ -216,7 +228,19 @@ void bindNavigation(py::module& m) {
         return py::make_tuple(w.x0, w.y0, w.x1, w.y1);
       }, "One update; returns the changed window (x0, y0, x1, y1) in cells.")
       .def("reset_obstacles", &LayeredCostmap::resetObstacles, py::arg("keep") = std::nullopt)
-      .def("master", [](const LayeredCostmap& l) { return l.master(); }, "A copy of the inflated master grid (_Costmap).");
+      .def("master", [](const LayeredCostmap& l) { return l.master(); }, "A copy of the inflated master grid (_Costmap).")
+      .def("set_filter_mask", [](LayeredCostmap& l, std::size_t index, py::array_t<int8_t, py::array::c_style | py::array::forcecast> data,
+                                 const Eigen::Vector2d& origin, double resolution) {
+             if (data.ndim() != 2) throw std::invalid_argument("set_filter_mask: data must be 2D (rows = y)");
+             l.setFilterMask(index, std::vector<int8_t>(data.data(), data.data() + data.size()), static_cast<int>(data.shape(1)),
+                             static_cast<int>(data.shape(0)), origin, resolution);
+           }, py::arg("index"), py::arg("data"), py::arg("origin"), py::arg("resolution"))
+      .def("take_filter_errors", &LayeredCostmap::takeFilterErrors)
+      .def("keepout_zone_at", &LayeredCostmap::keepoutZoneAt, py::arg("point"))
+      .def("speed_limit_at", [](const LayeredCostmap& l, const Eigen::Vector3d& pose) {
+        const auto s = l.speedLimitAt(pose);
+        return s.limited ? py::object(py::make_tuple(s.value, s.percent, s.zone)) : py::object(py::none());
+      }, py::arg("pose"), "(limit, percent, zone) under the footprint at pose, or None.");
 
   py::class_<LocalPlannerRosParams>(m, "LocalPlannerRosParams")
       .def_readonly("xy_goal_tolerance", &LocalPlannerRosParams::xy_goal_tolerance)

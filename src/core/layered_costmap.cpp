@@ -21,7 +21,11 @@ const std::map<std::string, std::string> kLayerTypes = {
     {"costmap_2d::ObstacleLayer", "obstacle"},
     {"costmap_2d::VoxelLayer", "obstacle"},  // a 2D obstacle layer here: the simulated lasers are planar
     {"costmap_2d::InflationLayer", "inflation"},
+    {"nav2_costmap_2d::KeepoutFilter", "keepout"},
+    {"nav2_costmap_2d::SpeedFilter", "speed"},
+    {"costmap_prohibition_layer_namespace::CostmapProhibitionLayer", "keepout"},
 };
+const char* const kProhibitionType = "costmap_prohibition_layer_namespace::CostmapProhibitionLayer";
 
 // Keys of move_base that tutorials put into costmap namespaces.
 const std::vector<std::string> kMoveBaseKeys = {
@@ -90,6 +94,73 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
                                       "a -inf range (nearer than range_min) marks an obstacle at range_min");
   r.reportUnknown();
   return s;
+}
+
+ZonePolygon readPolygon(const ParamValue& item, const std::string& where) {
+  ZonePolygon z;
+  z.name = where;
+  ParamValue points = item;
+  if (item.type == ParamValue::Type::kMap) {
+    const ParamValue* name = item.get("name");
+    const ParamValue* pts = item.get("points");
+    if (!pts) throw ParamError("parameter " + where + " must be [[x, y], ...] or {name: ..., points: [[x, y], ...]}");
+    if (name && name->type == ParamValue::Type::kString && !name->s.empty()) z.name = "'" + name->s + "'";
+    points = *pts;
+  }
+  for (const auto& p : parseFootprint(points, where)) z.points.push_back(p);
+  if (z.points.size() < 3) {
+    throw ParamError("parameter " + where + ": a zone's polygon needs at least 3 points, it has " +
+                     std::to_string(z.points.size()));
+  }
+  return z;
+}
+
+/// One filter's keys; a problem goes into the config's `error` (the costmap runs without it).
+FilterConfig readFilter(const std::string& name, const std::string& type, const std::string& kind, ParamReader& lr) {
+  FilterConfig f;
+  f.name = name;
+  f.type = type;
+  f.kind = kind == "speed" ? FilterConfig::Kind::kSpeed : FilterConfig::Kind::kKeepout;
+  f.enabled = lr.boolean("enabled", true, kEnabledDoc);
+  lr.ignored("filter_info_topic",
+             "Nav2's CostmapFilterInfo is not read: the filter takes its mask from mask_topic (and base, multiplier)");
+  lr.ignored("transform_tolerance", "masks must be in the costmap's global_frame");
+  try {
+    const ParamValue areas = lr.raw("prohibition_areas", ParamValue::ofList(),
+                                    "keep-out filter: zones as polygons in global_frame, [[[x, y], ...], ...] "
+                                    "(costmap_prohibition_layer's), or [{name: ..., points: [[x, y], ...]}, ...]",
+                                    "list");
+    if (areas.type != ParamValue::Type::kList) {
+      throw ParamError("parameter " + lr.where("prohibition_areas") + " must be a list of polygons, got " + areas.repr());
+    }
+    for (std::size_t i = 0; i < areas.items.size(); ++i) {
+      f.zones.push_back(readPolygon(areas.items[i], lr.where("prohibition_areas") + "[" + std::to_string(i) + "]"));
+    }
+    if (!f.zones.empty() && f.kind == FilterConfig::Kind::kSpeed) {
+      throw ParamError("parameter " + lr.where("prohibition_areas") + ": a speed filter takes its zones from mask_topic");
+    }
+    const bool prohibition = type == kProhibitionType;
+    const std::string topic_default = prohibition || !f.zones.empty() ? ""
+                                      : f.kind == FilterConfig::Kind::kSpeed ? "speed_filter_mask"
+                                                                              : "keepout_filter_mask";
+    f.mask_topic = lr.string("mask_topic", topic_default,
+                             "filters: the mask's nav_msgs/OccupancyGrid topic, as map_server serves a mask image "
+                             "(Nav2's default names: keepout_filter_mask, speed_filter_mask; '': polygons only)");
+    if (!f.mask_topic.empty() && !f.zones.empty()) {
+      throw ParamError("parameters " + lr.where("mask_topic") + " and " + lr.where("prohibition_areas") +
+                       ": give the zones one way, a mask or polygons");
+    }
+    if (f.mask_topic.empty() && f.zones.empty()) {
+      throw ParamError("parameter " + lr.where("prohibition_areas") + ": no zones (and no mask_topic)");
+    }
+    f.base = lr.number("base", f.base, "speed filter: limit = base + multiplier * mask value (Nav2's filter info)");
+    f.multiplier = lr.number("multiplier", f.multiplier, "speed filter: limit = base + multiplier * mask value");
+    f.percent = lr.boolean("speed_limit_in_percent", f.percent,
+                           "speed filter: the limit is a percentage of max_vel_x (false: [m/s])");
+  } catch (const ParamError& e) {
+    f.error = e.what();
+  }
+  return f;
 }
 
 }  // namespace
@@ -178,7 +249,7 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
   c.circumscribed_radius = circumscribedRadius(c.footprint);
 
   // Layers: (name, kind, reader of the layer's keys; the top-level reader for the pre-Hydro style).
-  std::vector<std::tuple<std::string, std::string, std::unique_ptr<ParamReader>>> layers;
+  std::vector<std::tuple<std::string, std::string, std::unique_ptr<ParamReader>, std::string>> layers;
   std::set<std::string> sub_namespaces;
   if (r.has("plugins")) {
     const ParamValue plugins = r.raw("plugins", ParamValue::ofList(), kPluginsDoc, "list");
@@ -205,22 +276,61 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
       sub_namespaces.insert(pname->s);
       layers.emplace_back(pname->s, kind->second,
                           std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
-                                                        ns + "/" + pname->s, warn));
+                                                        ns + "/" + pname->s, warn),
+                          ptype->s);
     }
   } else {
     // Pre-Hydro: the layers ROS builds from the old keys, which live at the top level.
     r.raw("plugins", ParamValue::ofList(), kPluginsDoc, "list");
     if (r.boolean("static_map", true, "without plugins: build a static layer from the map topic")) {
-      layers.emplace_back("static_layer", "static", nullptr);
+      layers.emplace_back("static_layer", "static", nullptr, "costmap_2d::StaticLayer");
     }
     const std::string map_type = r.string("map_type", "costmap", "without plugins: costmap or voxel (both 2D here)");
     if (map_type != "costmap" && map_type != "voxel") {
       throw ParamError("parameter " + r.where("map_type") + " must be costmap or voxel, got \"" + map_type + "\"");
     }
-    layers.emplace_back("obstacle_layer", "obstacle", nullptr);
-    layers.emplace_back("inflation_layer", "inflation", nullptr);
+    layers.emplace_back("obstacle_layer", "obstacle", nullptr, "costmap_2d::ObstacleLayer");
+    layers.emplace_back("inflation_layer", "inflation", nullptr, "costmap_2d::InflationLayer");
   }
-  for (auto& [layer_name, kind, reader] : layers) {
+  // Nav2's filters list: [{name: ..., type: ...}] or [name, ...] with <name>/plugin.
+  const ParamValue filters = r.raw("filters", ParamValue::ofList(),
+                                   "costmap filters, [{name: ..., type: nav2_costmap_2d::KeepoutFilter}, ...] "
+                                   "(KeepoutFilter, SpeedFilter, CostmapProhibitionLayer); with either style",
+                                   "list");
+  if (filters.type != ParamValue::Type::kList) {
+    throw ParamError("parameter " + r.where("filters") + " must be a list of {name, type}, got " + filters.repr());
+  }
+  for (std::size_t i = 0; i < filters.items.size(); ++i) {
+    const ParamValue& p = filters.items[i];
+    const std::string at = "parameter " + r.where("filters") + "[" + std::to_string(i) + "]";
+    std::string fname, ftype;
+    if (p.type == ParamValue::Type::kString) {
+      fname = p.s;
+      const ParamValue* sub = r.values().get(fname);
+      const ParamValue* t = sub ? sub->get("plugin") : nullptr;
+      if (!t) t = sub ? sub->get("type") : nullptr;
+      if (t && t->type == ParamValue::Type::kString) ftype = t->s;
+    } else if (const ParamValue *pn = p.get("name"), *pt = p.get("type"); pn && pt && pn->type == ParamValue::Type::kString &&
+                                                                          pt->type == ParamValue::Type::kString) {
+      fname = pn->s;
+      ftype = pt->s;
+    }
+    if (fname.empty() || ftype.empty()) {
+      throw ParamError(at + " must be {name: ..., type: ...} (or a name with <name>/plugin set), got " + p.repr());
+    }
+    const auto kind = kLayerTypes.find(ftype);
+    if (kind == kLayerTypes.end() || (kind->second != "keepout" && kind->second != "speed")) {
+      throw ParamError(at + ": \"" + ftype + "\" is not a filter; known: nav2_costmap_2d::KeepoutFilter, "
+                       "nav2_costmap_2d::SpeedFilter, " + kProhibitionType);
+    }
+    const ParamValue* lv = r.values().get(fname);
+    sub_namespaces.insert(fname);
+    layers.emplace_back(fname, kind->second,
+                        std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
+                                                      ns + "/" + fname, warn),
+                        ftype);
+  }
+  for (auto& [layer_name, kind, reader, type] : layers) {
     ParamReader& lr = reader ? *reader : r;
     c.layers.emplace_back(layer_name, kind);
     std::set<std::string> skip;
@@ -294,6 +404,9 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
       }));
       o.enabled = fallback(lr, r, "enabled", [&](ParamReader& p) { return p.boolean("enabled", d.enabled, kEnabledDoc); });
       c.obstacle_layer = o;
+    } else if (kind == "keepout" || kind == "speed") {
+      c.filters.push_back(readFilter(layer_name, type, kind, lr));
+      if (&lr != &r) lr.ignored("plugin", "the filter's type (Nav2's key)");
     } else {
       InflationLayerConfig f;
       const InflationLayerConfig d;
@@ -360,6 +473,7 @@ LayeredCostmap::LayeredCostmap(const CostmapConfig& config, Warn warn)
   } else {
     resize(1, 1, {config_.origin_x, config_.origin_y}, config_.resolution);  // sized by the first map
   }
+  masks_.resize(config_.filters.size());
   if (ob) {
     observations_.resize(ob->sources.size());
     last_stamp_.assign(ob->sources.size(), std::numeric_limits<double>::quiet_NaN());
@@ -415,6 +529,15 @@ void LayeredCostmap::setMap(const std::vector<int8_t>& data, int width, int heig
   static_ = std::move(incoming);
   static_valid_ = true;
   map_received_ = true;
+  for (std::size_t i = 0; i < masks_.size(); ++i) {
+    const FilterConfig& f = config_.filters[i];
+    if (!masks_[i].valid() || f.mask_topic.empty() || std::abs(masks_[i].resolution() - resolution) < 1e-6) continue;
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "the map has a resolution of %g m, the mask on %s %g m; the filter is left out until a mask "
+                  "of %g m arrives", resolution, f.mask_topic.c_str(), masks_[i].resolution(), resolution);
+    filter_errors_.push_back(f.name + ": " + buf);
+    masks_[i] = FilterMask();
+  }
   if (!config_.rolling_window && !same_geometry &&
       (master_.width() != width || master_.height() != height || std::abs(master_.resolution() - resolution) > 1e-9 ||
        (master_.origin() - origin).norm() > 1e-9)) {
@@ -520,6 +643,86 @@ void LayeredCostmap::compose(const CellWindow& w) {
       }
     }
   }
+  applyKeepout(w);
+}
+
+bool LayeredCostmap::filterUsable(std::size_t i) const {
+  const FilterConfig& f = config_.filters[i];
+  return f.enabled && f.error.empty() && masks_[i].valid() && std::abs(masks_[i].resolution() - master_.resolution()) < 1e-6;
+}
+
+void LayeredCostmap::applyKeepout(const CellWindow& w) {
+  std::vector<int> columns(static_cast<std::size_t>(std::max(w.x1 - w.x0, 0)));
+  for (std::size_t i = 0; i < masks_.size(); ++i) {
+    if (config_.filters[i].kind != FilterConfig::Kind::kKeepout || !filterUsable(i)) continue;
+    const FilterMask& mask = masks_[i];
+    const double res = base_.resolution();
+    for (int x = w.x0; x < w.x1; ++x) columns[x - w.x0] = mask.column(base_.origin().x() + (x + 0.5) * res);
+    for (int y = w.y0; y < w.y1; ++y) {
+      const int my = mask.row(base_.origin().y() + (y + 0.5) * res);
+      if (my < 0 || my >= mask.height()) continue;
+      const int8_t* m = mask.data().data() + static_cast<std::size_t>(my) * mask.width();
+      uint8_t* b = base_.costs().data() + static_cast<std::size_t>(y) * base_.width();
+      for (int x = w.x0; x < w.x1; ++x) {
+        const int mx = columns[x - w.x0];
+        if (mx < 0 || mx >= mask.width() || m[mx] <= 0) continue;
+        const uint8_t c = keepoutCost(m[mx]);
+        if (b[x] == cost::kNoInformation || c > b[x]) b[x] = c;  // Nav2's KeepoutFilter rule
+      }
+    }
+  }
+}
+
+void LayeredCostmap::setFilterMask(std::size_t index, const std::vector<int8_t>& data, int width, int height,
+                                   const Eigen::Vector2d& origin, double resolution) {
+  const FilterConfig& f = config_.filters.at(index);
+  const bool sized = !config_.static_layer || config_.rolling_window || map_received_;
+  if (sized && std::abs(resolution - master_.resolution()) > 1e-6) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "the mask's resolution is %g m, the costmap's %g m: draw the mask at the costmap's",
+                  resolution, master_.resolution());
+    throw std::invalid_argument(buf);
+  }
+  FilterMask mask;
+  mask.set(data, width, height, origin, resolution);
+  masks_[index] = std::move(mask);
+  if (f.kind == FilterConfig::Kind::kKeepout) full_ = true;
+}
+
+std::vector<std::string> LayeredCostmap::takeFilterErrors() {
+  std::vector<std::string> out;
+  out.swap(filter_errors_);
+  return out;
+}
+
+std::string LayeredCostmap::keepoutZoneAt(const Eigen::Vector2d& p) const {
+  for (std::size_t i = 0; i < masks_.size(); ++i) {
+    if (config_.filters[i].kind != FilterConfig::Kind::kKeepout || !filterUsable(i)) continue;
+    if (keepoutCost(masks_[i].valueAt(p)) < cost::kLethal) continue;
+    const int zone = masks_[i].zoneAt(p);
+    return (zone >= 0 ? masks_[i].zoneNames()[zone] : std::string("a zone")) + " (filter " + config_.filters[i].name + ")";
+  }
+  return "";
+}
+
+LayeredCostmap::SpeedLimit LayeredCostmap::speedLimitAt(const Eigen::Vector3d& pose) const {
+  SpeedLimit out;
+  std::vector<Cell> cells;
+  for (std::size_t i = 0; i < masks_.size(); ++i) {
+    const FilterConfig& f = config_.filters[i];
+    if (f.kind != FilterConfig::Kind::kSpeed || !filterUsable(i)) continue;
+    if (cells.empty()) cells = footprintCells(master_, pose, config_.footprint);
+    for (const Cell& c : cells) {
+      const Eigen::Vector2d p = master_.cellCenter(c);
+      const int8_t v = masks_[i].valueAt(p);
+      if (v <= 0) continue;
+      const double limit = f.base + f.multiplier * v;
+      if (out.limited && (out.percent != f.percent || limit >= out.value)) continue;
+      const int zone = masks_[i].zoneAt(p);
+      out = SpeedLimit{true, limit, f.percent, (zone >= 0 ? masks_[i].zoneNames()[zone] : "a zone") + " (filter " + f.name + ")"};
+    }
+  }
+  return out;
 }
 
 CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
@@ -564,6 +767,14 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
       for (const Cell& cell : too_close) obstacle_.setCost(cell, cost::kLethal);
       dirty_ = dirty_.unite(cellsAround(robot_pose.head<2>(), config_.circumscribed_radius + obstacle_.resolution()));
     }
+  }
+  for (std::size_t i = 0; i < masks_.size(); ++i) {
+    const FilterConfig& f = config_.filters[i];
+    if (!f.error.empty() || f.zones.empty() || (masks_[i].valid() && std::abs(masks_[i].resolution() - master_.resolution()) < 1e-6)) {
+      continue;
+    }
+    masks_[i].setPolygons(f.zones, master_.resolution());  // validated when read
+    full_ = true;
   }
   const int w = master_.width(), h = master_.height();
   CellWindow window = full_ ? CellWindow{0, 0, w, h} : dirty_.grown(0, w, h);

@@ -1,11 +1,17 @@
 // costmap_2d's layered costmap, ROS-free: its configuration (read from a costmap namespace, both
-// styles) and the master grid composed from a static, an obstacle and an inflation layer.
+// styles) and the master grid composed from a static, an obstacle and an inflation layer, and
+// costmap filters (keep-out and speed zones: core/costmap_filter.h).
 //
 // Configuration styles, as costmap_2d reads them:
 // - pre-Hydro (the tutorials): `static_map`, the obstacle keys (`observation_sources`,
 //   `obstacle_range`...) and the inflation keys at the top level of the costmap namespace;
 // - `plugins: [{name: ..., type: costmap_2d::StaticLayer}, ...]` with each layer's keys in
 //   `<costmap>/<name>/` (falling back to the top level, as ROS copies them there).
+// Filters go into either style's costmap as `filters: [{name: ..., type: ...}]` (Nav2's list,
+// entries also as a name with `<name>/plugin`), or as layers in `plugins`: types
+// nav2_costmap_2d::KeepoutFilter, nav2_costmap_2d::SpeedFilter and
+// costmap_prohibition_layer_namespace::CostmapProhibitionLayer. Wherever they are listed, keep-out
+// zones are combined before inflation.
 //
 // Values are costmap_2d's (0 free, 1..252 inflated, 253 inscribed, 254 lethal, 255 unknown); the
 // grid's cell (0, 0) has its corner at `origin` [m] in the costmap's global_frame.
@@ -24,6 +30,7 @@
 #include <Eigen/Core>
 
 #include "mbot_slam_navigation/core/costmap.h"
+#include "mbot_slam_navigation/core/costmap_filter.h"
 #include "mbot_slam_navigation/core/footprint.h"
 #include "mbot_slam_navigation/core/inflation_layer.h"
 #include "mbot_slam_navigation/core/laser_scan.h"
@@ -78,10 +85,11 @@ struct CostmapConfig {
   double footprint_padding = 0.01;
   Footprint footprint;  ///< padded, robot frame [m]
   double inscribed_radius = 0.0, circumscribed_radius = 0.0;
-  std::vector<std::pair<std::string, std::string>> layers;  ///< (name, kind: static, obstacle, inflation) in order
+  std::vector<std::pair<std::string, std::string>> layers;  ///< (name, kind: static, obstacle, inflation, keepout, speed) in order
   std::optional<StaticLayerConfig> static_layer;
   std::optional<ObstacleLayerConfig> obstacle_layer;
   std::optional<InflationLayerConfig> inflation_layer;
+  std::vector<FilterConfig> filters;  ///< keep-out and speed filters; one with an error is not used
 };
 
 /// Reads the namespace `ns_prefix/name` (its values given), warning about misplaced and misspelt
@@ -119,6 +127,28 @@ class LayeredCostmap {
   void resetObstacles(const std::optional<Eigen::Vector3d>& keep = std::nullopt);
 
   const Costmap& master() const { return master_; }
+
+  /// A mask for filter `index` of config().filters (OccupancyGrid data, as setMap). Throws
+  /// std::invalid_argument saying why when it cannot be used (its size, or a resolution other
+  /// than the costmap's); the filter then keeps its last good mask.
+  void setFilterMask(std::size_t index, const std::vector<int8_t>& data, int width, int height,
+                     const Eigen::Vector2d& origin, double resolution);
+  /// Problems found since the last call (a filter dropped because a new map has another
+  /// resolution than its mask), each naming the filter; for the user's error messages.
+  std::vector<std::string> takeFilterErrors();
+  /// The keep-out zone at world point `p` [m]: "ZONE (filter NAME)", or "" when none.
+  std::string keepoutZoneAt(const Eigen::Vector2d& p) const;
+  struct SpeedLimit {
+    bool limited = false;
+    double value = 0.0;    ///< percent of max_vel_x, or [m/s] when !percent
+    bool percent = true;
+    std::string zone;      ///< "ZONE (filter NAME)"
+  };
+  /// The lowest speed limit under the footprint at `pose` (global frame).
+  SpeedLimit speedLimitAt(const Eigen::Vector3d& pose) const;
+  /// The mask filter `index` uses (not valid before one arrived).
+  const FilterMask& filterMask(std::size_t index) const { return masks_.at(index); }
+
   /// Index of the observation source named `name`, or -1.
   int sourceIndex(const std::string& name) const;
 
@@ -130,6 +160,8 @@ class LayeredCostmap {
   };
   void resize(int width, int height, const Eigen::Vector2d& origin, double resolution);
   void compose(const CellWindow& window);
+  void applyKeepout(const CellWindow& window);
+  bool filterUsable(std::size_t index) const;
   CellWindow cellsAround(const Eigen::Vector2d& centre, double radius_m) const;
 
   CostmapConfig config_;
@@ -141,6 +173,8 @@ class LayeredCostmap {
   std::vector<std::vector<Observation>> observations_;  // not applied yet, or kept by observation_persistence
   std::vector<double> last_stamp_;                       // [s] per source, the newest scan's; NaN before any
   std::vector<bool> height_warned_;
+  std::vector<FilterMask> masks_;            // per config_.filters
+  std::vector<std::string> filter_errors_;  // not yet taken
   CellWindow dirty_;        // cells whose layers changed since the last update
   bool full_ = true;        // the whole grid must be recomposed
 };
