@@ -534,7 +534,7 @@ void LocalPlanner::updateOscillationFlags(const Eigen::Vector3d& pose, const Tra
 
 Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel) {
   const LocalPlannerParams& p = params_;
-  double max_vx = p.max_vel_x;
+  double max_vx = std::max(std::min(p.max_vel_x, speed_limit_), p.min_vel_x);
   if (goal_valid_) max_vx = std::min(max_vx, (final_goal_ - pose.head<2>()).norm() / p.sim_time);
   // The reachable window: one control period for DWA, the whole simulation for trajectory rollout.
   const double window = p.dwa ? p.sim_period : p.sim_time;

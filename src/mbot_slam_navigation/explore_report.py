@@ -19,7 +19,7 @@ from mbot_slam_navigation.maps.map_io import SAVER_FREE, SAVER_OCCUPIED, occupan
 from mbot_slam_navigation.nav.frontiers import Grid, inside_polygon
 from mbot_slam_navigation.sim.ground_truth import distance_to_surfaces, rasterize
 from mbot_slam_navigation.sim.sdf_world import World
-from mbot_slam_navigation.transforms import compose2d
+from mbot_slam_navigation.transforms import compose2d, inverse2d
 
 Pose2D = Tuple[float, float, float]
 
@@ -53,12 +53,16 @@ def known_area(m: Grid) -> float:
 
 
 def reachable_free_space(world: World, start: Tuple[float, float], robot_radius: float,
-                         resolution: float = 0.05, truth=None) -> Tuple[np.ndarray, Tuple[float, float]]:
+                         resolution: float = 0.05, truth=None,
+                         blocked: Optional[np.ndarray] = None) -> Tuple[np.ndarray, Tuple[float, float]]:
     """(mask, origin) of the world's free cells that the robot can sweep: those within robot_radius
     of a centre position reachable from `start` without touching any shape. `truth`: the world's
-    rasterize() at this resolution, if the caller has it (it takes a second or two)."""
+    rasterize() at this resolution, if the caller has it (it takes a second or two). `blocked` (a
+    mask of truth's cells: keep-out zones) counts as shapes, and its cells are never reachable."""
     truth, origin = truth if truth is not None else rasterize(world, resolution)
     free = (truth == 0).astype(np.uint8)
+    if blocked is not None:
+        free[blocked] = 0
     clearance = cv2.distanceTransform(free, cv2.DIST_L2, 5) * resolution
     centres = (clearance > robot_radius).astype(np.uint8)
     r, c = int((start[1] - origin[1]) / resolution), int((start[0] - origin[0]) / resolution)
@@ -71,12 +75,30 @@ def reachable_free_space(world: World, start: Tuple[float, float], robot_radius:
     return (swept > 0) & (free > 0), origin
 
 
+def keepout_on(truth, resolution: float, keepout: Grid, world_from_map: Pose2D = (0.0, 0.0, 0.0)) -> np.ndarray:
+    """Bool mask of the cells of `truth` ((grid, origin), world frame, `resolution` [m]) whose
+    centres lie on a forbidden cell (100) of `keepout` (a keep-out mask in the map frame)."""
+    grid, origin = truth
+    rows, cols = np.indices(grid.shape)
+    wx = origin[0] + (cols + 0.5) * resolution
+    wy = origin[1] + (rows + 0.5) * resolution
+    mx0, my0, myaw = inverse2d(world_from_map)
+    c, s = math.cos(myaw), math.sin(myaw)
+    mr, mc = keepout.cell_of(mx0 + c * wx - s * wy, my0 + s * wx + c * wy)
+    ok = keepout.inside(mr, mc)
+    out = np.zeros(grid.shape, bool)
+    out[ok] = keepout.data[mr[ok], mc[ok]] >= 100
+    return out
+
+
 def ground_truth_figures(m: Grid, world: World, start: Tuple[float, float], robot_radius: float,
-                         wall_tolerance: float = 0.1, truth=None, boundary=None) -> Dict[str, float]:
+                         wall_tolerance: float = 0.1, truth=None, boundary=None,
+                         keepout: Optional[np.ndarray] = None) -> Dict[str, float]:
     """Coverage of the reachable free space and the walls' distance to the world's surfaces; with
-    `boundary` ((N, 2) [m], world frame), the reachable space inside it only."""
+    `boundary` ((N, 2) [m], world frame), the reachable space inside it only; `keepout` (a mask of
+    truth's cells: keep-out zones) is neither reachable nor passable."""
     truth = truth if truth is not None else rasterize(world, m.resolution)
-    mask, origin = reachable_free_space(world, start, robot_radius, m.resolution, truth)
+    mask, origin = reachable_free_space(world, start, robot_radius, m.resolution, truth, keepout)
     if boundary is not None:
         mask = mask & inside_polygon(Grid(mask, m.resolution, origin), boundary)
     rows, cols = np.nonzero(mask)
@@ -191,7 +213,8 @@ def draw_area(curve: Sequence[Tuple[float, float]], filename: str, size=(800, 40
 
 
 def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World], start: Tuple[float, float],
-                 robot_radius: float, rooms, world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None) -> Dict:
+                 robot_radius: float, rooms, world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None,
+                 keepout: Optional[Grid] = None) -> Dict:
     """`figures` with the map's own (explored area; against the world when given: coverage, walls,
     each room's share), after writing the map (map.pgm, map.yaml) into report_dir. `start` and
     `boundary` (the explored area's polygon, coverage counted inside it) are in the map frame."""
@@ -203,7 +226,9 @@ def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World]
         truth = rasterize(world, m.resolution)  # once for all the figures below
         bounds = None if boundary is None else np.array([compose2d(world_from_map, (x, y, 0.0))[:2]
                                                          for x, y in boundary])
-        figures.update(ground_truth_figures(seen, world, start_world, robot_radius, truth=truth, boundary=bounds))
+        zones = None if keepout is None else keepout_on(truth, m.resolution, keepout, world_from_map)
+        figures.update(ground_truth_figures(seen, world, start_world, robot_radius, truth=truth, boundary=bounds,
+                                            keepout=zones))
         if rooms:
             figures['room_coverage'] = {k: round(v, 3) for k, v in
                                         room_coverage(seen, truth[0], truth[1], m.resolution, rooms=rooms).items()}
@@ -214,13 +239,15 @@ def _map_figures(report_dir: str, m: Grid, figures: Dict, world: Optional[World]
 def write_report(report_dir: str, m: Grid, path: List[Tuple[float, float]], goals: List[Tuple[float, float, bool]],
                  curve: List[Tuple[float, float]], figures: Dict, world: Optional[World] = None,
                  start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=(),
-                 world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None) -> Dict:
+                 world_from_map: Pose2D = (0.0, 0.0, 0.0), boundary=None, keepout: Optional[Grid] = None) -> Dict:
     """Writes map.pgm/map.yaml, map.png, area.png and report.json into report_dir; returns the figures.
     With `rooms` (home_rooms.Room) and the world, also the share of each room's floor mapped free.
     `world` holds the shapes that count (World.blocking for the robot's heights); the map, path,
     start and `boundary` (an explored area's polygon: coverage counts inside it) are in the map
-    frame, whose pose in the world is `world_from_map`."""
-    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms, world_from_map, boundary)
+    frame, whose pose in the world is `world_from_map`. `keepout` (a keep-out filter's mask, map
+    frame) is left out of the reachable space."""
+    figures = _map_figures(report_dir, m, dict(figures), world, start, robot_radius, rooms, world_from_map, boundary,
+                           keepout)
     draw_map(m, path, goals, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)

@@ -29,6 +29,35 @@ CostmapROS::CostmapROS(const std::string& name, tf2_ros::Buffer& tf, std::functi
     subscribers_.push_back(nh.subscribe(config.static_layer->map_topic, 1, &CostmapROS::onMap, this));
     ROS_INFO("%s: static layer waits for a map on %s", name.c_str(), subscribers_.back().getTopic().c_str());
   }
+  mask_received_ = std::vector<std::atomic<bool>>(config.filters.size());
+  for (std::size_t i = 0; i < config.filters.size(); ++i) {
+    const core::FilterConfig& f = config.filters[i];
+    if (!f.error.empty()) {
+      ROS_ERROR("%s: filter %s (%s) is left out: %s. The costmap goes on without it.", name.c_str(), f.name.c_str(),
+                f.type.c_str(), f.error.c_str());
+    } else if (!f.enabled) {
+      ROS_INFO("%s: filter %s is disabled (enabled: false)", name.c_str(), f.name.c_str());
+    } else if (!f.mask_topic.empty()) {
+      subscribers_.push_back(nh.subscribe<nav_msgs::OccupancyGrid>(
+          f.mask_topic, 1, [this, i](const nav_msgs::OccupancyGrid::ConstPtr& m) { onMask(m, i); }));
+      ROS_INFO("%s: %s filter %s waits for its mask on %s", name.c_str(),
+               f.kind == core::FilterConfig::Kind::kSpeed ? "speed" : "keep-out", f.name.c_str(),
+               subscribers_.back().getTopic().c_str());
+    } else {
+      ROS_INFO("%s: keep-out filter %s: %zu zones from prohibition_areas", name.c_str(), f.name.c_str(), f.zones.size());
+    }
+  }
+  // A mask that never comes (its map_server failed, or another topic) is said once, not waited for.
+  mask_watch_ = nh.createWallTimer(ros::WallDuration(10.0), [this](const ros::WallTimerEvent&) {
+    const auto& filters = layered_->config().filters;
+    for (std::size_t i = 0; i < filters.size(); ++i) {
+      if (filters[i].error.empty() && filters[i].enabled && !filters[i].mask_topic.empty() && !mask_received_[i]) {
+        ROS_WARN("%s: filter %s: no mask on %s after 10 s; the costmap goes on without it until one arrives (is a "
+                 "map_server serving the mask there? e.g. keepout_mask:=FILE.yaml)",
+                 name_.c_str(), filters[i].name.c_str(), ros::names::resolve(filters[i].mask_topic).c_str());
+      }
+    }
+  }, true);
   if (config.obstacle_layer) {
     for (std::size_t i = 0; i < config.obstacle_layer->sources.size(); ++i) {
       subscribers_.push_back(nh.subscribe<sensor_msgs::LaserScan>(
@@ -64,9 +93,68 @@ void CostmapROS::onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg) {
   if (std::abs(tf2::getYaw(info.origin.orientation)) > 1e-6) {
     ROS_WARN_THROTTLE(30, "%s: the map origin is rotated; costmaps use its position only", name_.c_str());
   }
+  {
+    std::lock_guard<std::mutex> guard(mutex_);
+    layered_->setMap(msg->data, static_cast<int>(info.width), static_cast<int>(info.height),
+                     {info.origin.position.x, info.origin.position.y}, info.resolution);
+  }
+  reportFilterErrors();
+}
+
+void CostmapROS::reportFilterErrors() {
+  std::vector<std::string> errors;
+  {
+    std::lock_guard<std::mutex> guard(mutex_);
+    errors = layered_->takeFilterErrors();
+  }
+  for (const auto& e : errors) ROS_ERROR("%s: filter %s", name_.c_str(), e.c_str());
+}
+
+void CostmapROS::onMask(const nav_msgs::OccupancyGrid::ConstPtr& msg, std::size_t index) {
+  const core::FilterConfig& f = config().filters[index];
+  const std::string topic = ros::names::resolve(f.mask_topic);
+  std::string frame = msg->header.frame_id;
+  while (!frame.empty() && frame[0] == '/') frame.erase(0, 1);
+  const auto& info = msg->info;
+  std::string why;
+  if (frame != config().global_frame) {
+    why = "the mask is in frame \"" + frame + "\", the costmap in \"" + config().global_frame +
+          "\" (serve the mask with frame_id " + config().global_frame + ")";
+  } else if (std::abs(tf2::getYaw(info.origin.orientation)) > 1e-6) {
+    why = "the mask's origin is rotated";
+  } else {
+    try {
+      std::lock_guard<std::mutex> guard(mutex_);
+      layered_->setFilterMask(index, msg->data, static_cast<int>(info.width), static_cast<int>(info.height),
+                              {info.origin.position.x, info.origin.position.y}, info.resolution);
+    } catch (const std::invalid_argument& e) {
+      why = e.what();
+    }
+  }
+  if (!why.empty()) {
+    ROS_ERROR("%s: filter %s: the mask on %s is ignored: %s. The costmap goes on without it.", name_.c_str(),
+              f.name.c_str(), topic.c_str(), why.c_str());
+    return;
+  }
+  mask_received_[index] = true;
+  std::string zones;
+  {
+    std::lock_guard<std::mutex> guard(mutex_);
+    for (const auto& z : layered_->filterMask(index).zoneNames()) zones += (zones.empty() ? "" : ", ") + z;
+  }
+  ROS_INFO("%s: %s filter %s: a mask of %u x %u cells from %s; zones: %s", name_.c_str(),
+           f.kind == core::FilterConfig::Kind::kSpeed ? "speed" : "keep-out", f.name.c_str(), info.width, info.height,
+           topic.c_str(), zones.empty() ? "none" : zones.c_str());
+}
+
+std::string CostmapROS::keepoutZoneAt(const Eigen::Vector2d& p) const {
   std::lock_guard<std::mutex> guard(mutex_);
-  layered_->setMap(msg->data, static_cast<int>(info.width), static_cast<int>(info.height),
-                   {info.origin.position.x, info.origin.position.y}, info.resolution);
+  return layered_->keepoutZoneAt(p);
+}
+
+core::LayeredCostmap::SpeedLimit CostmapROS::speedLimitAt(const Eigen::Vector3d& pose) const {
+  std::lock_guard<std::mutex> guard(mutex_);
+  return layered_->speedLimitAt(pose);
 }
 
 void CostmapROS::onScan(const sensor_msgs::LaserScan::ConstPtr& msg, std::size_t source) {

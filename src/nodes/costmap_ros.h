@@ -5,7 +5,10 @@
 // tf2 in global_frame; publishes ~<name>/costmap (nav_msgs/OccupancyGrid, the whole grid at
 // publish_frequency and to each new subscriber), ~<name>/costmap_updates
 // (map_msgs/OccupancyGridUpdate, the window that changed since the last publication, as costmap_2d
-// sends it) and ~<name>/footprint (geometry_msgs/PolygonStamped). Thread-safe: callbacks come from
+// sends it) and ~<name>/footprint (geometry_msgs/PolygonStamped). Each filter with a mask_topic
+// subscribes it (nav_msgs/OccupancyGrid in global_frame, at the costmap's resolution, as map_server
+// serves a mask image); a filter that cannot be used is reported once as an error and left out, and
+// the costmap goes on without it. Thread-safe: callbacks come from
 // an AsyncSpinner, the planner and controller read the grid under lock().
 #pragma once
 
@@ -48,6 +51,10 @@ class CostmapROS {
   void stop() { active_ = false; }
   void start() { active_ = true; }
 
+  /// The keep-out zone at `p` (global_frame), "" when none; see LayeredCostmap::keepoutZoneAt.
+  std::string keepoutZoneAt(const Eigen::Vector2d& p) const;
+  core::LayeredCostmap::SpeedLimit speedLimitAt(const Eigen::Vector3d& pose) const;
+
   /// The grid, valid while the lock is held.
   std::unique_lock<std::mutex> lock() { return std::unique_lock<std::mutex>(mutex_); }
   const core::Costmap& master() const { return layered_->master(); }
@@ -55,6 +62,8 @@ class CostmapROS {
  private:
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg, std::size_t source);
+  void onMask(const nav_msgs::OccupancyGrid::ConstPtr& msg, std::size_t filter);
+  void reportFilterErrors();
   void publishFootprint(const Eigen::Vector3d& pose);
 
   std::string name_;
@@ -69,6 +78,8 @@ class CostmapROS {
   ros::Publisher costmap_pub_, updates_pub_, footprint_pub_;
   std::vector<ros::Subscriber> subscribers_;
   ros::Timer update_timer_, publish_timer_;
+  ros::WallTimer mask_watch_;
+  std::vector<std::atomic<bool>> mask_received_;
 };
 
 }  // namespace ros_glue

@@ -245,6 +245,10 @@ class MoveBase {
       ROS_ERROR("make_plan: %s", why.c_str());
       return true;
     }
+    if (const std::string zone = keepoutZoneAt(*goal); !zone.empty()) {
+      ROS_WARN("make_plan: no plan to (%.2f, %.2f): it lies in keep-out zone %s", goal->x(), goal->y(), zone.c_str());
+      return true;
+    }
     Path2 path;
     bool ok;
     {
@@ -279,6 +283,13 @@ class MoveBase {
   // --- the action ------------------------------------------------------------------------------------
   void stop() { cmd_pub_.publish(geometry_msgs::Twist()); }
 
+  /// The keep-out zone (either costmap's filters) at `p` in the global costmap's frame, or "".
+  std::string keepoutZoneAt(const Vec3& p) {
+    std::string zone = global_->keepoutZoneAt(p.head<2>());
+    if (zone.empty() && !framesDiffer()) zone = local_->keepoutZoneAt(p.head<2>());
+    return zone;
+  }
+
   std::optional<Vec3> accept(const geometry_msgs::PoseStamped& target) {
     std::string why;
     const auto goal = inFrame(target, global_->config().global_frame, why);
@@ -286,6 +297,13 @@ class MoveBase {
       server_->setAborted(move_base_msgs::MoveBaseResult(),
                          "Aborting on goal because it was sent with an invalid quaternion or frame: " + why);
       ROS_ERROR("move_base: goal rejected: %s", why.c_str());
+      return std::nullopt;
+    }
+    if (const std::string zone = keepoutZoneAt(*goal); !zone.empty()) {
+      // A rule of the building, not a failure of move_base: said as a warning, the goal aborted at once.
+      const std::string text = fmt("the goal (%.2f, %.2f) lies in keep-out zone ", goal->x(), goal->y()) + zone;
+      server_->setAborted(move_base_msgs::MoveBaseResult(), "Aborting on goal because " + text);
+      ROS_WARN("move_base: goal rejected: %s", text.c_str());
       return std::nullopt;
     }
     std_msgs::Header header;
@@ -382,6 +400,7 @@ class MoveBase {
         control.why = "tf: " + mb_.local_->tfProblem();
         return control;
       }
+      mb_.applySpeedLimit(pose);
       auto guard = mb_.local_->lock();
       return mb_.controller_->compute(mb_.local_->master(), *local_pose, mb_.velocity());
     }
@@ -427,6 +446,32 @@ class MoveBase {
     MoveBase& mb_;
     std::map<std::string, ros::Time> last_said_;
   };
+
+  /// Caps the local planner's speed while the footprint at `pose` (global frame) is in a speed
+  /// zone of either costmap, saying so once per zone entered and once when it is lifted.
+  void applySpeedLimit(const Vec3& pose) {
+    auto limit = global_->speedLimitAt(pose);
+    if (!framesDiffer()) {
+      const auto local = local_->speedLimitAt(pose);
+      const double max_vel_x = controller_->params().max_vel_x;
+      auto mps = [&](const core::LayeredCostmap::SpeedLimit& l) { return l.percent ? l.value / 100.0 * max_vel_x : l.value; };
+      if (local.limited && (!limit.limited || mps(local) < mps(limit))) limit = local;
+    }
+    const double max_vel_x = controller_->params().max_vel_x;
+    const double cap = !limit.limited ? std::numeric_limits<double>::infinity()
+                       : limit.percent ? limit.value / 100.0 * max_vel_x : limit.value;
+    controller_->setSpeedLimit(cap);
+    const std::string zone = limit.limited ? limit.zone : "";
+    if (zone == speed_zone_) return;
+    speed_zone_ = zone;
+    if (zone.empty()) {
+      ROS_INFO("move_base: out of the speed zone: max_vel_x %.2f m/s again", max_vel_x);
+    } else {
+      const double effective = std::max(std::min(cap, max_vel_x), controller_->params().min_vel_x);
+      ROS_INFO("move_base: in speed zone %s: at most %.2f m/s%s", zone.c_str(), effective,
+               limit.percent ? fmt(" (%.0f%% of max_vel_x %.2f m/s)", limit.value, max_vel_x).c_str() : "");
+    }
+  }
 
   /// One control cycle; true when the goal is finished (succeeded or aborted).
   bool cycle(const Vec3& goal) {
@@ -625,6 +670,7 @@ class MoveBase {
   core::MoveBaseConfig config_;
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
   std::unique_ptr<core::TrajectoryController> controller_;
+  std::string speed_zone_;  // the speed zone the robot is in ("" none), for saying so once
   std::mutex velocity_mutex_, service_mutex_;
   Vec3 velocity_ = Vec3::Zero();
   ros::Publisher cmd_pub_, plan_pub_, generic_plan_pub_, local_plan_pub_, local_global_plan_pub_, goal_pub_, action_goal_pub_,

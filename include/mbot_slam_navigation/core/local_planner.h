@@ -148,6 +148,10 @@ class LocalPlanner {
   bool planAhead(const Eigen::Vector2d& point, double lookahead, Eigen::Vector2d* ahead) const;
   /// Recomputes the path and goal distance grids for `pose` without choosing a command.
   void updateGrids(const Costmap& map, const Eigen::Vector3d& pose);
+  /// Caps the forward speed sampled at `max_vel_x` [m/s] (a speed zone); infinity lifts the cap.
+  /// Never below min_vel_x.
+  void setSpeedLimit(double max_vel_x) { speed_limit_ = max_vel_x; }
+  double speedLimit() const { return speed_limit_; }
   /// Clears the oscillation and escape state (a new goal).
   void resetOscillation();
   /// false: score every footprint by its full outline walk (the reference the shortcuts must
@@ -215,6 +219,7 @@ class LocalPlanner {
   bool stuck_left_ = false, stuck_right_ = false, stuck_left_strafe_ = false, stuck_right_strafe_ = false;
   bool rotating_left_ = false, rotating_right_ = false, strafe_left_ = false, strafe_right_ = false;
   bool escaping_ = false;
+  double speed_limit_ = std::numeric_limits<double>::infinity();  // [m/s] setSpeedLimit
   Eigen::Vector2d prev_ = Eigen::Vector2d::Zero(), escape_ = Eigen::Vector2d::Zero();
   double escape_theta_ = 0.0;
   // Turning on the spot: where it started and how far it has turned since [rad].

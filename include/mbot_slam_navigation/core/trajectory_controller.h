@@ -52,6 +52,8 @@ class TrajectoryController {
   /// One control cycle. `reached()` turns true once within both tolerances.
   ControlResult compute(const Costmap& costmap, const Eigen::Vector3d& pose, const Eigen::Vector3d& velocity);
   bool reached() const { return reached_; }
+  /// LocalPlanner::setSpeedLimit.
+  void setSpeedLimit(double max_vel_x) { planner_.setSpeedLimit(max_vel_x); }
   const std::vector<Eigen::Vector2d>& plan() const { return plan_; }
   const std::vector<Eigen::Vector3d>& lastTrajectory() const { return last_trajectory_; }
   const LocalPlannerParams& params() const { return planner_.params(); }

@@ -81,6 +81,32 @@ def save_map(basename: str, data: np.ndarray, resolution: float, origin: Sequenc
 MODES = ('trinary', 'scale', 'raw')
 
 
+def save_mask(basename: str, values: np.ndarray, resolution: float, origin: Sequence[float], speed: bool = False) -> None:
+    """Writes a costmap filter's mask as map_server files (basename.pgm, basename.yaml, atomically).
+
+    Keep-out (`speed` False): cells of `values` at 100 are forbidden (black), the rest free (white);
+    trinary mode, so map_server serves 100 and 0. Speed: `values` are percentages 0..99 (0: no limit),
+    written in scale mode with occupied_thresh 1.0 and free_thresh 0.0 (Nav2's speed masks): map_server
+    serves floor(99 * darkness), and each grey is the darkest that still reads back as its value."""
+    values = np.asarray(values)
+    if speed:
+        if values.min() < 0 or values.max() > 99:
+            raise ValueError('speed mask values are percentages 0..99, got %g..%g' % (values.min(), values.max()))
+        img = (255 - np.ceil(values.astype(float) * 255.0 / 99.0)).clip(0, 255).astype(np.uint8)[::-1]
+        thresholds = {'mode': 'scale', 'occupied_thresh': 1.0, 'free_thresh': 0.0}
+    else:
+        img = np.where(values >= 100, OCCUPIED, FREE).astype(np.uint8)[::-1]
+        thresholds = {'mode': 'trinary', 'occupied_thresh': 0.65, 'free_thresh': 0.196}
+    h, w = img.shape
+    _atomic_write(basename + '.pgm', b'P5\n# CREATOR: mbot_slam_navigation mask %.3f m/pix\n%d %d\n255\n'
+                  % (resolution, w, h) + img.tobytes())
+    meta = {'image': os.path.basename(basename) + '.pgm', 'resolution': round(float(resolution), 6),
+            'origin': [round(float(v), 6) for v in (origin[0], origin[1], origin[2] if len(origin) > 2 else 0.0)],
+            'negate': 0}
+    meta.update(thresholds)
+    _atomic_write(basename + '.yaml', yaml.safe_dump(meta, default_flow_style=None, sort_keys=False).encode())
+
+
 class MapFileError(ValueError):
     """A map YAML or image that cannot be loaded; the message names the file and, where one is at
     fault, the key."""

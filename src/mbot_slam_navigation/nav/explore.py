@@ -186,6 +186,10 @@ def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> Simple
     boundary = r.raw('boundary', [], "[m] ours: [[x, y], ...] in global_frame: explore only inside this polygon "
                      "(frontier_exploration's; also the explore/boundary topic); []: everywhere", 'list')
     c.boundary = polygon_of(boundary, r.where('boundary'))
+    c.keepout_mask_topic = r.string('keepout_mask_topic', 'keepout_filter_mask',
+                                    "ours: a keep-out filter's mask (nav_msgs/OccupancyGrid, map frame; 100: forbidden), "
+                                    "as move_base's KeepoutFilter reads it: its zones make no frontiers and the report "
+                                    "leaves them out of the reachable space; '': none")
     return c
 
 
@@ -291,6 +295,13 @@ class Explore:
         self.boundary: Optional[np.ndarray] = c.boundary
         self.outside_m = 0.0  # [m] of frontier left out by the boundary at the last cycle
         rospy.Subscriber('explore/boundary', PolygonStamped, self.on_boundary, queue_size=1)
+        # Keep-out zones (move_base's keep-out filter's mask), map frame; None: none.
+        self.keepout: Optional[Grid] = None
+        self.keepout_m = 0.0  # [m] of frontier the zones took away at the last cycle
+        self.keepout_topic = c.keepout_mask_topic
+        if c.keepout_mask_topic:
+            rospy.Subscriber(c.keepout_mask_topic, numpy_msg(OccupancyGrid), self.on_keepout, queue_size=1,
+                             buff_size=2 ** 24)
         self.mates = {}  # name -> (ExplorerState, wall time received)
         self.team_pub = None
         if team_topic:
@@ -314,6 +325,18 @@ class Explore:
             return
         self.boundary = np.array([[p.x, p.y] for p in msg.polygon.points], float)
         rospy.loginfo('explore: exploring inside a boundary of %d points from explore/boundary' % len(self.boundary))
+
+    def on_keepout(self, msg: OccupancyGrid) -> None:
+        """The keep-out mask: its forbidden cells (100) are left unexplored."""
+        frame = msg.header.frame_id.lstrip('/')
+        if frame and frame != self.global_frame:
+            rospy.logerr('explore: the keep-out mask on %s is in frame "%s", not %s: ignored'
+                         % (rospy.resolve_name(self.keepout_topic), frame, self.global_frame))
+            return
+        mask = grid_of(msg)
+        self.keepout = mask
+        rospy.loginfo('explore: keep-out zones from %s: %.1f m^2 left unexplored'
+                      % (rospy.resolve_name(self.keepout_topic), np.count_nonzero(mask.data >= 100) * mask.resolution ** 2))
 
     def request_pause(self, pause: bool) -> TriggerResponse:
         """explore/pause and explore/resume (services), explore/resume (std_msgs/Bool, explore_lite's:
@@ -735,8 +758,10 @@ class Explore:
                                 avoid_goals=self.state.avoid_goals(now), unreachable=unreachable,
                                 keep_goal=self.state.goal.goal if self.state.goal is not None else None,
                                 min_unknown_beside=self.min_unknown_beside, gain_size_max=self.gain_size_max,
-                                enough=enough, eligible=lambda f: judge(f) is ELIGIBLE, boundary=self.boundary)
+                                enough=enough, eligible=lambda f: judge(f) is ELIGIBLE, boundary=self.boundary,
+                                keepout=self.keepout)
         self.outside_m = stats.get('outside_m', 0.0)
+        self.keepout_m = stats.get('keepout_m', 0.0)
         frontiers, waiting, given_up = self.state.screen(now, ranked, map_time)
         self.given_up = given_up + unreachable
         return frontiers, waiting, stats
@@ -882,6 +907,9 @@ class Explore:
             'boundary': None if self.boundary is None else [[round(float(x), 3), round(float(y), 3)]
                                                             for x, y in self.boundary],
             'frontier_outside_boundary_m': round(self.outside_m, 2),
+            'keepout_m2': (0.0 if self.keepout is None else
+                           round(float(np.count_nonzero(self.keepout.data >= 100)) * self.keepout.resolution ** 2, 2)),
+            'frontier_in_keepout_m': round(self.keepout_m, 2),
             'cpu_s_per_s_exploring': round(cpu_exploring / max(t_explored, 1e-6), 4),
             'longest_plateau_s': round(self.plateau.longest, 1),
             'longest_plateau_at_s': round(self.plateau.longest_at, 1),
@@ -900,7 +928,7 @@ class Explore:
                         rospy.logwarn('explore: no coverage per room: %s' % e)
             figures = explore_report.write_report(os.path.abspath(self.report_dir), self.map, self.path, self.goals,
                                                   self.curve, figures, world, start[:2], self.robot_radius, rooms,
-                                                  self.world_from_map, self.boundary)
+                                                  self.world_from_map, self.boundary, self.keepout)
             print('explore: report in %s (map.pgm, map.yaml, map.png, area.png, report.json)'
                   % os.path.abspath(self.report_dir), flush=True)
         for k, v in figures.items():

@@ -134,15 +134,32 @@ def inside_polygon(m: Grid, polygon) -> np.ndarray:
     return mask > 0
 
 
+def keepout_cells(mask: Grid, m: Grid) -> np.ndarray:
+    """Bool mask of the cells of m whose centres lie on a keep-out cell of `mask` (a costmap
+    filter's mask: OccupancyGrid values, 100 forbidden; any origin and resolution, same frame)."""
+    h, w = m.data.shape
+    mc, mr = mask.cell_of(m.centre_of(0, np.arange(w))[0], 0)[1], mask.cell_of(0, m.centre_of(np.arange(h), 0)[1])[0]
+    ok_r = (mr >= 0) & (mr < mask.data.shape[0])
+    ok_c = (mc >= 0) & (mc < mask.data.shape[1])
+    out = np.zeros((h, w), bool)
+    if ok_r.any() and ok_c.any():
+        out[np.ix_(ok_r, ok_c)] = mask.data[np.ix_(mr[ok_r], mc[ok_c])] >= 100
+    return out
+
+
 def _frontier_groups(m: Grid, unknown: np.ndarray, occupied_min: int, min_cells: int = 1,
-                     inside: Optional[np.ndarray] = None, stats: Optional[dict] = None) -> List[np.ndarray]:
+                     inside: Optional[np.ndarray] = None, stats: Optional[dict] = None,
+                     excluded: Optional[np.ndarray] = None) -> List[np.ndarray]:
     """The frontiers of at least min_cells cells, largest first (a large map has thousands of
     one- and two-cell fragments: they are counted, not listed). With `inside` (a mask of m), only
-    its cells count; stats['outside_m'] gets the frontier [m] left out."""
+    its cells count; stats['outside_m'] gets the frontier [m] left out. Cells of `excluded` (keep-out
+    zones) are never frontier cells."""
     data = m.data
     open_known = (data >= 0) & (data < occupied_min)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
     frontier = (open_known & (cv2.dilate(unknown, cross) > 0)).astype(np.uint8)
+    if excluded is not None:
+        frontier &= ~excluded
     if inside is not None:
         if stats is not None:
             stats['outside_m'] = float(np.count_nonzero(frontier & ~inside)) * m.resolution
@@ -232,7 +249,7 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
                    keep_goal: Optional[Tuple[float, float]] = None,
                    min_unknown_beside: float = 0.0, gain_size_max: float = 0.0, enough: int = 0,
                    eligible: Optional[Callable[[Frontier], bool]] = None,
-                   boundary: Optional[np.ndarray] = None) -> List[Frontier]:
+                   boundary: Optional[np.ndarray] = None, keepout: Optional[Grid] = None) -> List[Frontier]:
     """Reachable frontiers, best (lowest cost) first.
 
     Frontier cells within avoid_radius [m] of a point in `avoid` (places blacklisted or already
@@ -252,7 +269,9 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     `unreachable` too: it is not worth a trip.
 
     With `boundary` ((N, 2) [m], map frame: frontier_exploration's polygon) only the frontier cells
-    inside it count; stats['outside_m'] says how much frontier it left out.
+    inside it count; stats['outside_m'] says how much frontier it left out. With `keepout` (a keep-out
+    filter's mask, map frame) neither its cells nor the unknown space in it make frontiers;
+    stats['keepout_m'] says how much frontier that took away.
 
     A frontier's size counts in its cost up to gain_size_max [m] (0: no cap). Uncapped, the edge of
     the laser's view down a corridor (60 m of frontier in the office, seen from its lobby) outweighs
@@ -303,9 +322,22 @@ def rank_frontiers(m: Grid, costmap: Grid, robot: Tuple[float, float], min_front
     # beyond the grid's edge is unknown too (the SLAM map grows as the robot sees more)
     unknown_beyond = cv2.copyMakeBorder(unknown, g_reach, g_reach, g_reach, g_reach, cv2.BORDER_CONSTANT, value=1)
     inside = inside_polygon(m, boundary) if boundary is not None else None
+    zone = keepout_cells(keepout, m) if keepout is not None else None
+    if zone is not None and zone.any():
+        if stats is not None:
+            # what the zone takes away: frontier cells in it, and those whose unknown lies in it only
+            open_known = (m.data >= 0) & (m.data < occupied_min)
+            cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+            before = open_known & (cv2.dilate(unknown, cross) > 0)
+            after = open_known & (cv2.dilate(unknown & ~zone, cross) > 0) & ~zone
+            stats['keepout_m'] = float(np.count_nonzero(before & ~after)) * m.resolution
+        unknown = unknown & ~zone
+        unknown_beyond = cv2.copyMakeBorder(unknown, g_reach, g_reach, g_reach, g_reach, cv2.BORDER_CONSTANT, value=1)
+    elif stats is not None:
+        stats['keepout_m'] = 0.0
     groups = [g for g in _frontier_groups(m, unknown, occupied_min,
                                           max(1, int(math.ceil(min_frontier_size / m.resolution - 1e-9))),
-                                          inside, stats)
+                                          inside, stats, excluded=zone)
               if len(g) * m.resolution >= min_frontier_size]
 
     def evaluate(g: np.ndarray) -> Optional[Frontier]:
