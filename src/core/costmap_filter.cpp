@@ -113,7 +113,7 @@ void FilterMask::labelZones(const std::vector<std::string>& names) {
       continue;
     }
     char buf[96];
-    std::snprintf(buf, sizeof buf, "zone %d at (%.1f, %.1f)", k, origin_.x() + (centroids.at<double>(k, 0) + 0.5) * resolution_,
+    std::snprintf(buf, sizeof buf, "#%d at (%.1f, %.1f)", k, origin_.x() + (centroids.at<double>(k, 0) + 0.5) * resolution_,
                   origin_.y() + (centroids.at<double>(k, 1) + 0.5) * resolution_);
     zone_names_.push_back(buf);
   }

@@ -17,7 +17,10 @@ CostmapROS::CostmapROS(const std::string& name, tf2_ros::Buffer& tf, std::functi
   XmlRpc::XmlRpcValue values;
   if (!pnh.getParam(name, values)) values = XmlRpc::XmlRpcValue();
   const auto warn = [](const std::string& text) { ROS_WARN("%s", text.c_str()); };
-  const core::CostmapConfig config = core::readCostmapConfig(name, fromXmlRpc(values), warn, ros::this_node::getName());
+  core::CostmapConfig config = core::readCostmapConfig(name, fromXmlRpc(values), warn, ros::this_node::getName());
+  for (auto& f : config.filters) {
+    if (!f.mask_topic.empty()) f.mask_topic = ros::names::resolve(f.mask_topic);  // named so in messages
+  }
   layered_ = std::make_unique<core::LayeredCostmap>(config, warn);
   // A new subscriber gets the whole grid at the next publication (costmap_2d's onNewSubscription).
   costmap_pub_ = pnh.advertise<nav_msgs::OccupancyGrid>(

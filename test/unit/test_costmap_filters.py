@@ -42,7 +42,7 @@ def test_keepout_mask_is_lethal_and_inflated_as_a_wall_and_named():
     assert at(lc, 1.9, 2.5) == INSCRIBED   # within the robot's radius of the zone: the footprint would enter
     assert 0 < at(lc, 1.6, 2.5) < INSCRIBED
     assert at(lc, 0.5, 0.5) == FREE
-    assert lc.keepout_zone_at((2.5, 2.5)) == 'zone 1 at (2.5, 2.5) (filter keepout_filter)'
+    assert lc.keepout_zone_at((2.5, 2.5)) == '#1 at (2.5, 2.5) (filter keepout_filter)'
     assert lc.keepout_zone_at((1.0, 1.0)) == ''
 
 

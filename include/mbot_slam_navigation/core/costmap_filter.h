@@ -11,7 +11,7 @@
 //   planner's max_vel_x (speed_limit_in_percent, the default) or [m/s]; 0 and -1 do not limit.
 //
 // A zone is a connected region (8-connected) of the mask's non-zero cells. It is named by its
-// polygon's name, or "zone K at (x, y)" with the centre of its cells [m] for a mask.
+// polygon's name, or "#K at (x, y)" with the centre of its cells [m] for a mask.
 #pragma once
 
 #include <cstdint>
