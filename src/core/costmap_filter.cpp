@@ -48,6 +48,23 @@ void FilterMask::set(const std::vector<int8_t>& data, int width, int height, con
   resolution_ = resolution;
   data_ = data;
   labelZones({});
+  findRuns();
+}
+
+void FilterMask::findRuns() {
+  runs_.assign(height_, {});
+  for (int r = 0; r < height_; ++r) {
+    const int8_t* row = data_.data() + static_cast<std::size_t>(r) * width_;
+    for (int c = 0; c < width_;) {
+      if (row[c] <= 0) {
+        ++c;
+        continue;
+      }
+      const int begin = c;
+      while (c < width_ && row[c] > 0) ++c;
+      runs_[r].emplace_back(begin, c);
+    }
+  }
 }
 
 void FilterMask::setPolygons(const std::vector<ZonePolygon>& zones, double resolution) {
@@ -91,6 +108,7 @@ void FilterMask::setPolygons(const std::vector<ZonePolygon>& zones, double resol
       labels_[i] = row_ptr[c] - 1;
     }
   }
+  findRuns();
 }
 
 void FilterMask::labelZones(const std::vector<std::string>& names) {

@@ -652,22 +652,23 @@ bool LayeredCostmap::filterUsable(std::size_t i) const {
 }
 
 void LayeredCostmap::applyKeepout(const CellWindow& w) {
-  std::vector<int> columns(static_cast<std::size_t>(std::max(w.x1 - w.x0, 0)));
   for (std::size_t i = 0; i < masks_.size(); ++i) {
     if (config_.filters[i].kind != FilterConfig::Kind::kKeepout || !filterUsable(i)) continue;
     const FilterMask& mask = masks_[i];
+    // Same resolution (filterUsable): the costmap's cell x lies on the mask's column x + dx.
     const double res = base_.resolution();
-    for (int x = w.x0; x < w.x1; ++x) columns[x - w.x0] = mask.column(base_.origin().x() + (x + 0.5) * res);
+    const int dx = mask.column(base_.origin().x() + 0.5 * res), dy = mask.row(base_.origin().y() + 0.5 * res);
     for (int y = w.y0; y < w.y1; ++y) {
-      const int my = mask.row(base_.origin().y() + (y + 0.5) * res);
+      const int my = y + dy;
       if (my < 0 || my >= mask.height()) continue;
       const int8_t* m = mask.data().data() + static_cast<std::size_t>(my) * mask.width();
       uint8_t* b = base_.costs().data() + static_cast<std::size_t>(y) * base_.width();
-      for (int x = w.x0; x < w.x1; ++x) {
-        const int mx = columns[x - w.x0];
-        if (mx < 0 || mx >= mask.width() || m[mx] <= 0) continue;
-        const uint8_t c = keepoutCost(m[mx]);
-        if (b[x] == cost::kNoInformation || c > b[x]) b[x] = c;  // Nav2's KeepoutFilter rule
+      for (const auto& [begin, end] : mask.runs(my)) {
+        const int x0 = std::max(begin - dx, w.x0), x1 = std::min(end - dx, w.x1);
+        for (int x = x0; x < x1; ++x) {
+          const uint8_t c = keepoutCost(m[x + dx]);
+          if (b[x] == cost::kNoInformation || c > b[x]) b[x] = c;  // Nav2's KeepoutFilter rule
+        }
       }
     }
   }

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -67,9 +68,13 @@ class FilterMask {
   /// The zone at `p` (index into zoneNames()), or -1.
   int zoneAt(const Eigen::Vector2d& p) const;
   const std::vector<std::string>& zoneNames() const { return zone_names_; }
+  /// The runs [begin, end) of non-zero cells of row `r`, left to right (a mask is mostly empty:
+  /// combining it into a costmap visits its zones' cells only).
+  const std::vector<std::pair<int, int>>& runs(int r) const { return runs_[r]; }
 
  private:
   void labelZones(const std::vector<std::string>& names);
+  void findRuns();
 
   int width_ = 0, height_ = 0;
   double resolution_ = 0.0;
@@ -77,6 +82,7 @@ class FilterMask {
   std::vector<int8_t> data_;
   std::vector<int> labels_;  ///< per cell: zone index, -1 outside every zone
   std::vector<std::string> zone_names_;
+  std::vector<std::vector<std::pair<int, int>>> runs_;  ///< per row
 };
 
 }  // namespace core
