@@ -31,6 +31,8 @@ COSTMAP_LAYERS = {
                 {'name': 'obstacle_layer', 'type': 'costmap_2d::ObstacleLayer'},
                 {'name': 'inflation_layer', 'type': 'costmap_2d::InflationLayer'}],
     'obstacle_layer': {'observation_sources': '<source>', '<source>': {'data_type': 'LaserScan'}},
+    'filters': [{'name': 'keepout_filter', 'type': 'nav2_costmap_2d::KeepoutFilter'},
+                {'name': 'speed_filter', 'type': 'nav2_costmap_2d::SpeedFilter'}],
 }
 
 

@@ -126,23 +126,23 @@ FilterConfig readFilter(const std::string& name, const std::string& type, const 
              "Nav2's CostmapFilterInfo is not read: the filter takes its mask from mask_topic (and base, multiplier)");
   lr.ignored("transform_tolerance", "masks must be in the costmap's global_frame");
   try {
-    const ParamValue areas = lr.raw("prohibition_areas", ParamValue::ofList(),
-                                    "keep-out filter: zones as polygons in global_frame, [[[x, y], ...], ...] "
-                                    "(costmap_prohibition_layer's), or [{name: ..., points: [[x, y], ...]}, ...]",
-                                    "list");
-    if (areas.type != ParamValue::Type::kList) {
-      throw ParamError("parameter " + lr.where("prohibition_areas") + " must be a list of polygons, got " + areas.repr());
-    }
-    for (std::size_t i = 0; i < areas.items.size(); ++i) {
-      f.zones.push_back(readPolygon(areas.items[i], lr.where("prohibition_areas") + "[" + std::to_string(i) + "]"));
-    }
-    if (!f.zones.empty() && f.kind == FilterConfig::Kind::kSpeed) {
-      throw ParamError("parameter " + lr.where("prohibition_areas") + ": a speed filter takes its zones from mask_topic");
+    const bool speed = f.kind == FilterConfig::Kind::kSpeed;
+    if (!speed) {
+      const ParamValue areas = lr.raw("prohibition_areas", ParamValue::ofList(),
+                                      "keep-out filter: zones as polygons in global_frame, [[[x, y], ...], ...] "
+                                      "(costmap_prohibition_layer's), or [{name: ..., points: [[x, y], ...]}, ...]",
+                                      "list");
+      if (areas.type != ParamValue::Type::kList) {
+        throw ParamError("parameter " + lr.where("prohibition_areas") + " must be a list of polygons, got " + areas.repr());
+      }
+      for (std::size_t i = 0; i < areas.items.size(); ++i) {
+        f.zones.push_back(readPolygon(areas.items[i], lr.where("prohibition_areas") + "[" + std::to_string(i) + "]"));
+      }
     }
     const bool prohibition = type == kProhibitionType;
     const std::string topic_default = prohibition || !f.zones.empty() ? ""
-                                      : f.kind == FilterConfig::Kind::kSpeed ? "speed_filter_mask"
-                                                                              : "keepout_filter_mask";
+                                      : speed                          ? "speed_filter_mask"
+                                                                       : "keepout_filter_mask";
     f.mask_topic = lr.string("mask_topic", topic_default,
                              "filters: the mask's nav_msgs/OccupancyGrid topic, as map_server serves a mask image "
                              "(Nav2's default names: keepout_filter_mask, speed_filter_mask; '': polygons only)");
@@ -151,12 +151,15 @@ FilterConfig readFilter(const std::string& name, const std::string& type, const 
                        ": give the zones one way, a mask or polygons");
     }
     if (f.mask_topic.empty() && f.zones.empty()) {
-      throw ParamError("parameter " + lr.where("prohibition_areas") + ": no zones (and no mask_topic)");
+      throw ParamError(speed ? "parameter " + lr.where("mask_topic") + " is empty: a speed filter needs a mask"
+                             : "parameter " + lr.where("prohibition_areas") + ": no zones (and no mask_topic)");
     }
-    f.base = lr.number("base", f.base, "speed filter: limit = base + multiplier * mask value (Nav2's filter info)");
-    f.multiplier = lr.number("multiplier", f.multiplier, "speed filter: limit = base + multiplier * mask value");
-    f.percent = lr.boolean("speed_limit_in_percent", f.percent,
-                           "speed filter: the limit is a percentage of max_vel_x (false: [m/s])");
+    if (speed) {
+      f.base = lr.number("base", f.base, "speed filter: limit = base + multiplier * mask value (Nav2's filter info)");
+      f.multiplier = lr.number("multiplier", f.multiplier, "speed filter: limit = base + multiplier * mask value");
+      f.percent = lr.boolean("speed_limit_in_percent", f.percent,
+                             "speed filter: the limit is a percentage of max_vel_x (false: [m/s])");
+    }
   } catch (const ParamError& e) {
     f.error = e.what();
   }
