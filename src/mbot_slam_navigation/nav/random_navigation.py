@@ -37,8 +37,10 @@ import rospy
 import tf2_ros
 import yaml
 from actionlib_msgs.msg import GoalStatus
-from geometry_msgs.msg import Point, Pose, PoseWithCovarianceStamped, Quaternion, Twist
+from geometry_msgs.msg import Point, Pose, PoseStamped, PoseWithCovarianceStamped, Quaternion, Twist, Vector3
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+from std_msgs.msg import ColorRGBA
+from visualization_msgs.msg import Marker
 
 from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
@@ -226,7 +228,102 @@ def read_parameters(r: ParamReader) -> dict:
     return c
 
 
-class RandomNavigation:
+def next_marker(pose: PoseStamped, label: str) -> Marker:
+    """The point being driven to, for rviz: a green arrow (0.5 m) at `pose`, labelled in its text."""
+    m = Marker(type=Marker.ARROW, action=Marker.ADD, ns='next_point', id=0)
+    m.header = pose.header
+    m.pose = pose.pose
+    m.scale = Vector3(0.5, 0.08, 0.08)
+    m.color = ColorRGBA(0.1, 0.8, 0.2, 1.0)
+    m.text = label
+    return m
+
+
+class GoalSender:
+    """Sends one move_base goal at a time and sees it through move_base's faults (pursue). Users
+    set move_base (a SimpleActionClient), goal_timeout and server_timeout [s], and goal(loc)."""
+    log_name = 'random_navigation'
+
+    def stop_requested(self) -> bool:
+        """True when the goal being pursued is to be given up (a preempted waypoint action)."""
+        return False
+
+    def server_silence(self) -> float:
+        """[s] of ROS time since move_base's last action status (inf before the first)."""
+        last = self.move_base.action_client.last_status_msg
+        return (rospy.Time.now() - last.header.stamp).to_sec() if last is not None else float('inf')
+
+    def pursue(self, loc: Location) -> Optional[str]:
+        """Sends the goal and waits for its end (goal_timeout); the state's name, or None at shutdown.
+
+        move_base killed mid-goal (and respawned by roslaunch) is noticed two ways: its status
+        stops (SERVER_SILENCE s), or the new process's status does not know the goal (actionlib
+        calls it LOST). Either way the same goal is sent again once move_base answers, at most
+        MAX_RESENDS times, so the count goes on; if it does not come back within server_timeout the
+        goal counts as LOST."""
+        deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
+        resends = blocked = 0
+        self.move_base.send_goal(self.goal(loc))
+        while not rospy.is_shutdown():
+            if self.stop_requested():
+                self.move_base.cancel_goal()
+                return 'PREEMPTED'
+            if self.move_base.wait_for_result(rospy.Duration(1.0)):
+                code = self.move_base.get_state()
+                text = self.move_base.get_goal_status_text()
+                how = next((h for reason, h in BLOCKED_REASONS.items() if reason in text), None)
+                if (code == GoalStatus.ABORTED and how and blocked < BLOCKED_RETRIES
+                        and rospy.Time.now() + rospy.Duration(BLOCKED_WAIT) < deadline):
+                    blocked += 1
+                    rospy.logwarn(self.log_name + ': move_base aborted the goal to %s as %s (%s); waiting %g s '
+                                  'for the way to clear (a person passing?), then sending it again (%d of %d)',
+                                  loc.name, how, text, BLOCKED_WAIT, blocked, BLOCKED_RETRIES)
+                    try:
+                        rospy.sleep(BLOCKED_WAIT)
+                    except rospy.ROSTimeMovedBackwardsException:
+                        pass
+                    except rospy.ROSInterruptException:
+                        return None
+                    self.move_base.send_goal(self.goal(loc))
+                    continue
+                if code != GoalStatus.LOST or resends >= MAX_RESENDS:
+                    return GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
+                why = 'lost the goal (it was restarted?)'
+            elif rospy.Time.now() > deadline:
+                self.move_base.cancel_goal()
+                return 'TIMED_OUT'
+            elif self.server_silence() > SERVER_SILENCE:
+                why = 'has sent no status for %.0f s (it died or hangs)' % self.server_silence()
+            else:
+                continue
+            if resends >= MAX_RESENDS:
+                return 'LOST'
+            rospy.logwarn(self.log_name + ': move_base (%s) %s during the goal to %s; waiting up to %g s '
+                          '(server_timeout) for it to answer, then sending the goal again',
+                          rospy.resolve_name('move_base'), why, loc.name, self.server_timeout)
+            if not self.move_base.wait_for_server(rospy.Duration(self.server_timeout)):
+                if rospy.is_shutdown():
+                    return None
+                rospy.logerr(self.log_name + ': move_base did not come back within %g s; the goal to %s counts '
+                             'as LOST', self.server_timeout, loc.name)
+                return 'LOST'
+            answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)
+            while self.server_silence() > SERVER_SILENCE and rospy.Time.now() < answer_by:
+                try:
+                    rospy.sleep(0.2)  # connected: wait for the new process's first status
+                except rospy.ROSTimeMovedBackwardsException:
+                    answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)  # a reset: wait afresh
+                except rospy.ROSInterruptException:
+                    return None
+            resends += 1
+            rospy.loginfo(self.log_name + ': move_base answers again; sending the goal to %s again', loc.name)
+            self.move_base.send_goal(self.goal(loc))
+            deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
+        return None
+
+
+
+class RandomNavigation(GoalSender):
     """The node (the tutorial's NavTest): run() sends the goals and returns the exit code."""
 
     def __init__(self):
@@ -246,6 +343,7 @@ class RandomNavigation:
         self.rng = random.Random(None if seed < 0 else seed)
 
         self.cmd_vel_pub = rospy.Publisher('cmd_vel', Twist, queue_size=5)
+        self.marker_pub = rospy.Publisher('~next_point', Marker, queue_size=1, latch=True)
         self.move_base = SimpleActionClient('move_base', MoveBaseAction)
         # /tf read lazily: only the pose lookups (a few a second) deserialize it; a
         # TransformListener would deserialize all 40-odd messages a simulated second
@@ -320,6 +418,8 @@ class RandomNavigation:
             distance = math.hypot(loc.x - position[0], loc.y - position[1])
             i += 1
             rospy.loginfo('Going to: %s%s', loc.name, ' (%s)' % loc.room if loc.room else '')
+            self.marker_pub.publish(next_marker(self.goal(loc).target_pose, loc.name + (' (%s)' % loc.room
+                                                                                        if loc.room else '')))
             self.goal_active = True
             state = self.pursue(loc)
             if state is None:
@@ -355,76 +455,6 @@ class RandomNavigation:
         if self.start_time is not None:
             rospy.loginfo(self.tally.summary(self.running_time(), self.locations))
         return 0
-
-    def server_silence(self) -> float:
-        """[s] of ROS time since move_base's last action status (inf before the first)."""
-        last = self.move_base.action_client.last_status_msg
-        return (rospy.Time.now() - last.header.stamp).to_sec() if last is not None else float('inf')
-
-    def pursue(self, loc: Location) -> Optional[str]:
-        """Sends the goal and waits for its end (goal_timeout); the state's name, or None at shutdown.
-
-        move_base killed mid-goal (and respawned by roslaunch) is noticed two ways: its status
-        stops (SERVER_SILENCE s), or the new process's status does not know the goal (actionlib
-        calls it LOST). Either way the same goal is sent again once move_base answers, at most
-        MAX_RESENDS times, so the count goes on; if it does not come back within server_timeout the
-        goal counts as LOST."""
-        deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
-        resends = blocked = 0
-        self.move_base.send_goal(self.goal(loc))
-        while not rospy.is_shutdown():
-            if self.move_base.wait_for_result(rospy.Duration(1.0)):
-                code = self.move_base.get_state()
-                text = self.move_base.get_goal_status_text()
-                how = next((h for reason, h in BLOCKED_REASONS.items() if reason in text), None)
-                if (code == GoalStatus.ABORTED and how and blocked < BLOCKED_RETRIES
-                        and rospy.Time.now() + rospy.Duration(BLOCKED_WAIT) < deadline):
-                    blocked += 1
-                    rospy.logwarn('random_navigation: move_base aborted the goal to %s as %s (%s); waiting %g s '
-                                  'for the way to clear (a person passing?), then sending it again (%d of %d)',
-                                  loc.name, how, text, BLOCKED_WAIT, blocked, BLOCKED_RETRIES)
-                    try:
-                        rospy.sleep(BLOCKED_WAIT)
-                    except rospy.ROSTimeMovedBackwardsException:
-                        pass
-                    except rospy.ROSInterruptException:
-                        return None
-                    self.move_base.send_goal(self.goal(loc))
-                    continue
-                if code != GoalStatus.LOST or resends >= MAX_RESENDS:
-                    return GOAL_STATES[code] if 0 <= code < len(GOAL_STATES) else str(code)
-                why = 'lost the goal (it was restarted?)'
-            elif rospy.Time.now() > deadline:
-                self.move_base.cancel_goal()
-                return 'TIMED_OUT'
-            elif self.server_silence() > SERVER_SILENCE:
-                why = 'has sent no status for %.0f s (it died or hangs)' % self.server_silence()
-            else:
-                continue
-            if resends >= MAX_RESENDS:
-                return 'LOST'
-            rospy.logwarn('random_navigation: move_base (%s) %s during the goal to %s; waiting up to %g s '
-                          '(server_timeout) for it to answer, then sending the goal again',
-                          rospy.resolve_name('move_base'), why, loc.name, self.server_timeout)
-            if not self.move_base.wait_for_server(rospy.Duration(self.server_timeout)):
-                if rospy.is_shutdown():
-                    return None
-                rospy.logerr('random_navigation: move_base did not come back within %g s; the goal to %s counts '
-                             'as LOST', self.server_timeout, loc.name)
-                return 'LOST'
-            answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)
-            while self.server_silence() > SERVER_SILENCE and rospy.Time.now() < answer_by:
-                try:
-                    rospy.sleep(0.2)  # connected: wait for the new process's first status
-                except rospy.ROSTimeMovedBackwardsException:
-                    answer_by = rospy.Time.now() + rospy.Duration(self.server_timeout)  # a reset: wait afresh
-                except rospy.ROSInterruptException:
-                    return None
-            resends += 1
-            rospy.loginfo('random_navigation: move_base answers again; sending the goal to %s again', loc.name)
-            self.move_base.send_goal(self.goal(loc))
-            deadline = rospy.Time.now() + rospy.Duration(self.goal_timeout)
-        return None
 
     def stop_robot(self) -> None:
         self.cmd_vel_pub.publish(Twist())
