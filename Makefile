@@ -38,10 +38,18 @@ test: build
 # opens rviz.
 RVIZ ?= 0
 # ROBOTS=2 (up to 4): a team explores together (launch/multi_explore.launch), one report for all.
+# HOSTS=separate: each robot on a host of its own and a base station (network namespaces of this
+# machine, tools/multi_host.py; needs root).
+HOSTS ?= one
 demo: build
+ifeq ($(HOSTS),separate)
+	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/tools/multi_host.py --robots $(or $(ROBOTS),2) \
+	  --report-dir $(CURDIR)/report --max-duration 1200 --launch-arg rviz:=$(if $(filter 1 true,$(RVIZ)),true,false)
+else
 	cd $(WS) && $(SOURCE) && rosrun $(PKG) run_exploration $(PKG) \
 	  $(if $(filter-out 1,$(or $(ROBOTS),1)),multi_explore.launch robots:=$(ROBOTS),explore.launch) \
 	  report_dir:=$(CURDIR)/report real_time_factor:=auto max_duration:=1200 rviz:=$(if $(filter 1 true,$(RVIZ)),true,false)
+endif
 
 bench: build
 	cd $(WS) && $(SOURCE) && /usr/bin/python3 $(CURDIR)/bench/run_all.py
