@@ -77,7 +77,13 @@ class Hosts:
         run('ip', 'link', 'set', self.links[k][1], 'up' if up else 'down', ns=self.robots[k])
 
     def netem(self, k: int, spec: str) -> None:
-        run('tc', 'qdisc', 'add', 'dev', self.links[k][1], 'root', 'netem', *shlex.split(spec), ns=self.robots[k])
+        try:
+            run('tc', 'qdisc', 'add', 'dev', self.links[k][1], 'root', 'netem', *shlex.split(spec), ns=self.robots[k])
+        except RuntimeError as e:
+            if 'qdisc kind is unknown' in str(e):
+                raise RuntimeError('--netem: this kernel has no netem queueing discipline (sch_netem, %s); delay '
+                                   'and loss cannot be added here' % os.uname().release) from None
+            raise
 
     def remove(self) -> None:
         for ns in reversed(self.made):
