@@ -235,6 +235,11 @@ void bindNavigation(py::module& m) {
              l.setFilterMask(index, std::vector<int8_t>(data.data(), data.data() + data.size()), static_cast<int>(data.shape(1)),
                              static_cast<int>(data.shape(0)), origin, resolution);
            }, py::arg("index"), py::arg("data"), py::arg("origin"), py::arg("resolution"))
+      .def("patch_map", [](LayeredCostmap& l, py::array_t<int8_t, py::array::c_style | py::array::forcecast> data, int x, int y) {
+             if (data.ndim() != 2) throw std::invalid_argument("patch_map: data must be 2D (rows = y)");
+             return l.patchMap(std::vector<int8_t>(data.data(), data.data() + data.size()), x, y,
+                               static_cast<int>(data.shape(1)), static_cast<int>(data.shape(0)));
+           }, py::arg("data"), py::arg("x"), py::arg("y"))
       .def("take_filter_errors", &LayeredCostmap::takeFilterErrors)
       .def("keepout_zone_at", &LayeredCostmap::keepoutZoneAt, py::arg("point"))
       .def("speed_limit_at", [](const LayeredCostmap& l, const Eigen::Vector3d& pose) {

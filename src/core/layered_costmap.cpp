@@ -564,6 +564,25 @@ void LayeredCostmap::setMap(const std::vector<int8_t>& data, int width, int heig
   }
 }
 
+bool LayeredCostmap::patchMap(const std::vector<int8_t>& data, int x, int y, int width, int height) {
+  if (!config_.static_layer || !static_valid_ || width < 0 || height < 0 ||
+      data.size() != static_cast<std::size_t>(width) * height || x < 0 || y < 0 || x + width > static_.width() ||
+      y + height > static_.height()) {
+    return false;
+  }
+  for (int r = 0; r < height; ++r) {
+    uint8_t* row = static_.costs().data() + static_cast<std::size_t>(y + r) * static_.width() + x;
+    const int8_t* in = data.data() + static_cast<std::size_t>(r) * width;
+    for (int c = 0; c < width; ++c) row[c] = staticCost(in[c], *config_.static_layer);
+  }
+  if (config_.rolling_window) {
+    full_ = true;
+  } else {
+    dirty_ = dirty_.unite(CellWindow{x, y, x + width, y + height});
+  }
+  return true;
+}
+
 bool LayeredCostmap::addScan(std::size_t source, double stamp, const Eigen::Vector3d& sensor_pose, double sensor_height,
                              const LaserScan& scan) {
   const auto& src = config_.obstacle_layer->sources.at(source);

@@ -31,6 +31,9 @@ CostmapROS::CostmapROS(const std::string& name, tf2_ros::Buffer& tf, std::functi
   if (config.static_layer) {
     subscribers_.push_back(nh.subscribe(config.static_layer->map_topic, 1, &CostmapROS::onMap, this));
     ROS_INFO("%s: static layer waits for a map on %s", name.c_str(), subscribers_.back().getTopic().c_str());
+    if (config.static_layer->subscribe_to_updates) {
+      map_updates_sub_ = nh.subscribe(config.static_layer->map_topic + "_updates", 10, &CostmapROS::onMapUpdate, this);
+    }
   }
   mask_received_ = std::vector<std::atomic<bool>>(config.filters.size());
   for (std::size_t i = 0; i < config.filters.size(); ++i) {
@@ -102,6 +105,20 @@ void CostmapROS::onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg) {
                      {info.origin.position.x, info.origin.position.y}, info.resolution);
   }
   reportFilterErrors();
+}
+
+void CostmapROS::onMapUpdate(const map_msgs::OccupancyGridUpdate::ConstPtr& msg) {
+  bool applied;
+  {
+    std::lock_guard<std::mutex> guard(mutex_);
+    applied = layered_->patchMap(msg->data, msg->x, msg->y, static_cast<int>(msg->width), static_cast<int>(msg->height));
+  }
+  if (!applied) {
+    // costmap_2d's StaticLayer would write past its map; here the update waits for a whole map
+    ROS_WARN_THROTTLE(10, "%s: an update on %s (%u x %u cells at %d, %d) does not fit the map held; ignored until "
+                      "the next whole map", name_.c_str(), map_updates_sub_.getTopic().c_str(), msg->width, msg->height,
+                      msg->x, msg->y);
+  }
 }
 
 void CostmapROS::reportFilterErrors() {

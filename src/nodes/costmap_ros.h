@@ -1,7 +1,8 @@
 // Costmap2DROS: a LayeredCostmap (core) fed by ROS topics and tf2, published for rviz.
 //
 // Subscribes the static layer's map topic (nav_msgs/OccupancyGrid, latched or repeated, so it follows
-// a growing SLAM map) and each LaserScan observation source; looks the robot and the sensors up in
+// a growing SLAM map; with subscribe_to_updates also <map_topic>_updates, map_msgs/OccupancyGridUpdate,
+// as costmap_2d's StaticLayer) and each LaserScan observation source; looks the robot and the sensors up in
 // tf2 in global_frame; publishes ~<name>/costmap (nav_msgs/OccupancyGrid, the whole grid at
 // publish_frequency and to each new subscriber), ~<name>/costmap_updates
 // (map_msgs/OccupancyGridUpdate, the window that changed since the last publication, as costmap_2d
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -61,6 +63,7 @@ class CostmapROS {
 
  private:
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+  void onMapUpdate(const map_msgs::OccupancyGridUpdate::ConstPtr& msg);
   void onScan(const sensor_msgs::LaserScan::ConstPtr& msg, std::size_t source);
   void onMask(const nav_msgs::OccupancyGrid::ConstPtr& msg, std::size_t filter);
   void reportFilterErrors();
@@ -77,6 +80,7 @@ class CostmapROS {
   core::CellWindow unpublished_;
   ros::Publisher costmap_pub_, updates_pub_, footprint_pub_;
   std::vector<ros::Subscriber> subscribers_;
+  ros::Subscriber map_updates_sub_;
   ros::Timer update_timer_, publish_timer_;
   ros::WallTimer mask_watch_;
   std::vector<std::atomic<bool>> mask_received_;

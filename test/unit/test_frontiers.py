@@ -625,3 +625,37 @@ def test_the_boundary_parameter_is_checked_by_name():
     for bad in ([[0, 0], [1, 0]], [[0, 0], [1], [1, 1]], [[0, 0], [1, 'a'], [1, 1]], 'square'):
         with pytest.raises(ParamError, match='/explore/boundary must be a list of at least 3'):
             polygon_of(bad, '/explore/boundary')
+
+
+def test_a_keepout_zone_makes_no_frontier_and_counts_what_it_took():
+    """A room with its door open onto unknown space: a keep-out mask over the space beyond the door
+    leaves no frontier (it is excluded, not unreachable), and stats['keepout_m'] counts the door."""
+    m = room(door=(1.0, 2.0))
+    c = costmap_of(m)
+    assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.5)  # the door's frontier
+    # the mask: its own grid (another origin), forbidden east of the room's east wall (x >= 5.05 m)
+    mask = np.zeros((160, 220), np.int8)  # 11 m x 8 m from (-1, -1)
+    mask[:, int(round((5.05 + 1.0) / RES)):] = 100
+    keepout = Grid(mask, RES, (-1.0, -1.0))
+    stats, unreachable = {}, []
+    assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.5, keepout=keepout, stats=stats,
+                          unreachable=unreachable) == []
+    assert unreachable == []
+    assert stats['keepout_m'] == pytest.approx(1.0, abs=0.15)  # the 1 m door
+    # a zone elsewhere takes nothing away
+    far = Grid(np.full((10, 10), 100, np.int8), RES, (0.0, 5.0))
+    stats = {}
+    assert rank_frontiers(m, c, (2.0, 2.0), min_frontier_size=0.5, keepout=far, stats=stats)
+    assert stats['keepout_m'] == 0.0
+
+
+def test_map_updates_patch_a_copy_and_refuse_what_does_not_fit():
+    from types import SimpleNamespace
+    from mbot_slam_navigation.nav.explore import patched_grid
+    m = room()
+    update = SimpleNamespace(x=10, y=20, width=3, height=2, data=[100] * 6)
+    p = patched_grid(m, update)
+    assert (p.data[20:22, 10:13] == 100).all() and m.data[20, 10] != 100  # the old grid is untouched
+    assert p.origin == m.origin and p.resolution == m.resolution
+    assert patched_grid(m, SimpleNamespace(x=159, y=0, width=3, height=1, data=[0] * 3)) is None
+    assert patched_grid(None, update) is None

@@ -300,3 +300,25 @@ def test_a_laser_covered_by_a_person_is_marked_inside_the_footprint_that_clearin
         lc.add_scan('scan', 2.0, pose, 0.1, -math.pi, 2 * math.pi / 36, 0.1, 6.0, [1.0] * 36)
         lc.update(pose)
         assert costs_of(lc)[ahead[1], ahead[0]] == FREE
+
+
+def test_map_updates_patch_the_static_layer_as_a_whole_map_would():
+    """subscribe_to_updates: a window of the map replaced gives the costmap a whole new map gives;
+    an update that does not fit the map held changes nothing."""
+    values = dict(tutorial_costmap('global_costmap'))
+    base = np.zeros((60, 80), np.int8)
+    base[30, :] = 100
+    patched = LayeredCostmap(CostmapConfig('global_costmap', values, lambda w: None), print)
+    whole = LayeredCostmap(CostmapConfig('global_costmap', values, lambda w: None), print)
+    patched.set_map(base, (0.0, 0.0), 0.05)
+    patched.update((0.5, 0.5, 0.0))
+    after = base.copy()
+    after[10:20, 40:50] = 100
+    after[30, 5:15] = 0  # a door opened in the wall
+    window = after[10:31, 5:50]
+    assert patched.patch_map(window, 5, 10)
+    patched.update((0.5, 0.5, 0.0))
+    whole.set_map(after, (0.0, 0.0), 0.05)
+    whole.update((0.5, 0.5, 0.0))
+    assert np.array_equal(costs_of(patched), costs_of(whole))
+    assert not patched.patch_map(np.zeros((5, 5), np.int8), 78, 0)  # past the map's edge

@@ -112,6 +112,10 @@ class LayeredCostmap {
 
   /// A new map for the static layer (OccupancyGrid data, rows = y, origin of cell (0, 0) [m]).
   void setMap(const std::vector<int8_t>& data, int width, int height, const Eigen::Vector2d& origin, double resolution);
+  /// A window of the static layer's map replaced (map_msgs/OccupancyGridUpdate: `data` rows of
+  /// `width` cells, the window's corner at cell (x, y) of the current map). False, changing
+  /// nothing, before the first map or for a window outside it (the caller waits for a whole map).
+  bool patchMap(const std::vector<int8_t>& data, int x, int y, int width, int height);
   /// Buffers one scan of source `source` (sensor pose in the global frame, height [m] above it).
   /// False (warning once per source) when the sensor's height is outside the source's
   /// [min_obstacle_height, max_obstacle_height]: costmap_2d drops every point of such a scan.

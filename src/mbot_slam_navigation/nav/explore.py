@@ -49,6 +49,7 @@ import tf2_ros
 from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import Point, PolygonStamped, Twist, Vector3
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+from map_msgs.msg import OccupancyGridUpdate
 from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, ColorRGBA
@@ -103,6 +104,18 @@ def grid_of(msg: OccupancyGrid) -> Grid:
                 (msg.info.origin.position.x, msg.info.origin.position.y))
 
 
+def patched_grid(m: Optional[Grid], msg) -> Optional[Grid]:
+    """`m` with the window of a map_msgs/OccupancyGridUpdate replaced (a new Grid: readers may hold
+    the old one), or None when the update does not fit it (before the first whole map, or one of
+    another size: wait for the next whole map)."""
+    x, y, w, h = msg.x, msg.y, msg.width, msg.height
+    if m is None or x + w > m.data.shape[1] or y + h > m.data.shape[0] or len(msg.data) != w * h:
+        return None
+    data = m.data.copy()
+    data[y:y + h, x:x + w] = np.asarray(msg.data, np.int8).reshape(h, w)
+    return Grid(data, m.resolution, m.origin)
+
+
 def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> SimpleNamespace:
     """explore's parameters: explore_lite's names and defaults, then ours; checked (ParamError)."""
     c = SimpleNamespace()
@@ -112,6 +125,10 @@ def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> Simple
                                "move_base's global costmap: goals are placed and paths measured on it")
     r.string('costmap_updates_topic', '', "explore_lite's; not used (the full costmap topic is enough here)")
     c.map_topic = r.string('map_topic', 'map', "ours: the SLAM map, whose frontiers are explored")
+    c.subscribe_to_updates = r.boolean('subscribe_to_updates', False,
+                                       "ours: also read <map_topic>_updates (map_msgs/OccupancyGridUpdate), as "
+                                       "costmap_2d's static layer does: a map sent whole only when it grows "
+                                       "(map_merge's publish_updates)")
     c.planner_frequency = r.number('planner_frequency', 0.33, '[Hz] how often frontiers are found and a goal chosen',
                                    positive=True)
     c.potential_scale = r.number('potential_scale', POTENTIAL_SCALE, "weight of a frontier's path length in its cost", minimum=0.0)
@@ -270,6 +287,8 @@ class Explore:
         # grid: 0.01 ms instead of 2.4 ms here)
         # Started by the same roslaunch as SLAM and move_base: a connection rospy lost while both
         # registered is made again during the start-up wait (topic_watch).
+        if c.subscribe_to_updates:
+            rospy.Subscriber(map_topic + '_updates', numpy_msg(OccupancyGridUpdate), self.on_map_update, queue_size=10)
         self.inputs = [WatchedSubscriber(map_topic, numpy_msg(OccupancyGrid), self.on_map, queue_size=1,
                                          buff_size=2 ** 24),
                        WatchedSubscriber(costmap_topic, numpy_msg(OccupancyGrid), self.on_costmap, queue_size=1,
@@ -377,6 +396,18 @@ class Explore:
     def on_map(self, msg: OccupancyGrid) -> None:
         self.map = grid_of(msg)
         self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
+        if self.start_time is not None:
+            self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
+
+    def on_map_update(self, msg: OccupancyGridUpdate) -> None:
+        """A window of the map replaced (a new Grid: the explorer's loop may hold the old one)."""
+        m = patched_grid(self.map, msg)
+        if m is None:
+            rospy.logwarn_throttle(10, 'explore: an update on %s_updates does not fit the map held; ignored until the '
+                                   'next whole map' % rospy.resolve_name(self.map_topic))
+            return
+        self.map = m
+        self.map_with_stamp = (self.map, msg.header.stamp)
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
 
