@@ -5,8 +5,8 @@ is added to the machine's own namespace), one ROS master on the base, launch/bas
 there, launch/robot.launch on each robot host with ROS_IP set to its address. Everything is torn
 down at the end, also on a failure or Ctrl-C.
 
-    tools/multi_host.py --robots 2 --report-dir report [--world FILE] [--max-duration S]
-        [--launch-arg name:=value ...] [--netem "delay 100ms loss 2%"] [--cut robot2:60:10]
+    tools/multi_host.py --robots 2 --report-dir report [--world FILE] [--spawn x,y[,yaw] ...]
+        [--max-duration S] [--launch-arg name:=value ...] [--netem "delay 100ms loss 2%"] [--cut robot2:60:10]
 
 --netem applies tc netem to every robot's link; --cut ROBOT:AT:FOR takes ROBOT's link down AT
 seconds (wall) after the robots start, for FOR seconds. Prints the team's one line and the bytes
@@ -138,7 +138,11 @@ def main(argv=None) -> int:
     ap.add_argument('--max-duration', type=float, default=1200.0, help='[s] simulated, per explorer')
     ap.add_argument('--timeout', type=float, default=3600.0, help='[s] wall, for the whole run')
     ap.add_argument('--launch-arg', action='append', default=[], help='name:=value for base_station.launch')
+    ap.add_argument('--spawn', action='append', default=[],
+                    help="x,y[,yaw]: a robot's start in the world, once per robot in order (default: the home's)")
     ap.add_argument('--netem', default='', help='tc netem on every robot link, e.g. "delay 100ms loss 2%%"')
+    ap.add_argument('--bad-ros-ip', default='', metavar='ROBOT',
+                    help='start robotK with ROS_IP=127.0.0.1 (a misconfigured host, to see it reported)')
     ap.add_argument('--cut', default='', help='ROBOT:AT:FOR: robotK link down AT s (wall) after the start, FOR s')
     a = ap.parse_args(argv)
     if os.geteuid() != 0:
@@ -154,6 +158,11 @@ def main(argv=None) -> int:
         name, at, length = a.cut.split(':')
         cut = (int(name.replace('robot', '')) - 1, float(at), float(length))
     world = ['world_name:=' + os.path.abspath(a.world)] if a.world else []
+    spawns = list(SPAWNS)
+    for k, text in enumerate(a.spawn[:4]):
+        v = [float(t) for t in text.split(',')]
+        spawns[k] = (v[0], v[1], v[2] if len(v) > 2 else 0.0)
+    poses = ['%s%d:=%g' % (key, k + 1, v) for k in range(a.robots) for key, v in zip(('x', 'y', 'yaw'), spawns[k])]
     hosts = Hosts(a.robots)
     procs: List[subprocess.Popen] = []
     signal.signal(signal.SIGTERM, _terminated)
@@ -166,12 +175,12 @@ def main(argv=None) -> int:
             '%s (%s)' % (ns, ip) for ns, ip in zip(hosts.robots, hosts.ips))), flush=True)
         procs.append(start(hosts.base, BASE_IP, ['mbot_slam_navigation', 'base_station.launch',
                                                  'robots:=%d' % a.robots, 'report_dir:=' + report_dir,
-                                                 'max_duration:=%g' % a.max_duration] + world + a.launch_arg,
+                                                 'max_duration:=%g' % a.max_duration] + world + poses + a.launch_arg,
                            os.path.join(report_dir, 'base_station.log')))
         for k in range(a.robots):
-            x, y, yaw = SPAWNS[k]
+            x, y, yaw = spawns[k]
             name = 'robot%d' % (k + 1)
-            procs.append(start(hosts.robots[k], hosts.ips[k],
+            procs.append(start(hosts.robots[k], '127.0.0.1' if a.bad_ros_ip == name else hosts.ips[k],
                                ['--wait', 'mbot_slam_navigation', 'robot.launch', 'ns:=' + name, 'x:=%g' % x,
                                 'y:=%g' % y, 'yaw:=%g' % yaw, 'report_dir:=' + os.path.join(report_dir, name),
                                 'max_duration:=%g' % a.max_duration] + world,

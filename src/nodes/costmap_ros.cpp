@@ -32,7 +32,7 @@ CostmapROS::CostmapROS(const std::string& name, tf2_ros::Buffer& tf, std::functi
     subscribers_.push_back(nh.subscribe(config.static_layer->map_topic, 1, &CostmapROS::onMap, this));
     ROS_INFO("%s: static layer waits for a map on %s", name.c_str(), subscribers_.back().getTopic().c_str());
     if (config.static_layer->subscribe_to_updates) {
-      map_updates_sub_ = nh.subscribe(config.static_layer->map_topic + "_updates", 10, &CostmapROS::onMapUpdate, this);
+      map_updates_sub_ = nh.subscribe(config.static_layer->map_topic + "_updates", 100, &CostmapROS::onMapUpdate, this);
     }
   }
   mask_received_ = std::vector<std::atomic<bool>>(config.filters.size());

@@ -129,3 +129,29 @@ def test_the_nearest_robot_places_a_wall_both_saw():
     a2[:, 60:] = -1
     m2 = merge([(Grid(a2, 0.05, (0.0, -4.0)), at), (gb, at)], trails=[trail_a, trail_b])
     assert (m2.data[112, 60:] == 100).all() and (m2.data[110, :60] == 100).all()
+
+
+def test_a_map_padded_to_blocks_keeps_its_cells_in_place_and_grows_by_blocks():
+    from mbot_slam_navigation.maps.merge import padded_to_blocks
+    data = np.arange(7 * 9, dtype=np.int8).reshape(7, 9)
+    m = Grid(data, 0.05, (-0.35, 0.15))  # not on a block's edge
+    p = padded_to_blocks(m, 0.2)  # blocks of 4 cells
+    assert p.data.shape[0] % 4 == 0 and p.data.shape[1] % 4 == 0
+    r, c = p.cell_of(m.centre_of(3, 5)[0], m.centre_of(3, 5)[1])
+    assert p.data[r, c] == data[3, 5]
+    assert (p.data == -1).sum() == p.data.size - data.size
+    # a map grown by one cell inside the same block keeps the padded size and origin
+    m2 = Grid(np.zeros((7, 10), np.int8), 0.05, (-0.35, 0.15))
+    p2 = padded_to_blocks(m2, 0.2)
+    assert p2.data.shape == p.data.shape and p2.origin == pytest.approx(p.origin)
+    assert p.origin == pytest.approx((-0.4, 0.0))  # block edges: multiples of 0.2 m
+
+
+def test_changes_far_apart_go_in_windows_of_their_own():
+    from mbot_slam_navigation.maps.merge import changed_windows
+    changed = np.zeros((100, 200), bool)
+    changed[10:12, 5:9] = True
+    changed[13, 15] = True        # near the first: the same window
+    changed[80:90, 150:160] = True
+    assert sorted(changed_windows(changed, 20)) == [(10, 14, 5, 16), (80, 90, 150, 160)]
+    assert changed_windows(np.zeros((5, 5), bool), 20) == []

@@ -11,7 +11,7 @@ saw the same place from elsewhere. OpenCV does the warping (nearest cell) and th
 (ORB and a RANSAC fit of a rotation and translation, as multirobot_map_merge does).
 """
 import math
-from typing import Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -161,3 +161,34 @@ def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius
     data = m.data.copy()
     data[(mask > 0) & (data >= SAVER_OCCUPIED)] = 0
     return Grid(data, m.resolution, m.origin)
+
+
+def padded_to_blocks(m: Grid, block: float) -> Grid:
+    """`m` grown with unknown cells to whole blocks of `block` [m] aligned on the world origin, so that
+    its size and origin change only when the explored part crosses a block's edge."""
+    n = max(1, int(round(block / m.resolution)))
+    c0 = int(np.floor(m.origin[0] / m.resolution + 1e-6))
+    r0 = int(np.floor(m.origin[1] / m.resolution + 1e-6))
+    left, bottom = c0 - (c0 // n) * n, r0 - (r0 // n) * n
+    h, w = m.data.shape
+    right = (-(left + w)) % n
+    top = (-(bottom + h)) % n
+    data = np.pad(m.data, ((bottom, top), (left, right)), constant_values=-1)
+    origin = (m.origin[0] - left * m.resolution, m.origin[1] - bottom * m.resolution) + tuple(m.origin[2:])
+    return Grid(data, m.resolution, origin)
+
+
+def changed_windows(changed: np.ndarray, gap: int) -> List[Tuple[int, int, int, int]]:
+    """(r0, r1, c0, c1) windows covering the True cells of `changed`, one per group of cells less
+    than `gap` cells apart (their bounding boxes; a window may overlap another)."""
+    if not changed.any():
+        return []
+    near = cv2.dilate(changed.astype(np.uint8), np.ones((gap, gap), np.uint8))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(near, connectivity=8)
+    out = []
+    for k in range(1, n):
+        x, y, w, h = (int(v) for v in stats[k, :4])
+        inside = changed[y:y + h, x:x + w] & (labels[y:y + h, x:x + w] == k)
+        rows, cols = np.flatnonzero(inside.any(axis=1)), np.flatnonzero(inside.any(axis=0))
+        out.append((y + int(rows[0]), y + int(rows[-1]) + 1, x + int(cols[0]), x + int(cols[-1]) + 1))
+    return out

@@ -36,12 +36,14 @@ for a robot when no frontier is left to anyone.
 """
 import math
 import os
+import threading
 import time
 import traceback
 from types import SimpleNamespace
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
+import rosgraph
 import rospy
 from rospy.numpy_msg import numpy_msg
 from actionlib import SimpleGoalState
@@ -59,6 +61,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from mbot_slam_navigation import _core, explore_report
 from mbot_slam_navigation.batched_reads import clock_at_most_every
 from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
+from mbot_slam_navigation.host_check import address_problem
 from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
@@ -230,6 +233,9 @@ class Explore:
         r = ParamReader(rospy.get_param('~', {}), rospy.get_name(), rospy.logwarn)
         c = read_parameters(r, rospy.get_namespace().strip('/') or 'robot')
         r.report_unknown()
+        problem = address_problem(rosgraph.get_master_uri(), rospy.get_node_uri() or '')
+        if problem:
+            rospy.logerr('explore: %s', problem)
         self.base_frame = c.robot_base_frame
         self.global_frame = c.global_frame
         self.costmap_topic = costmap_topic = c.costmap_topic
@@ -287,8 +293,9 @@ class Explore:
         # grid: 0.01 ms instead of 2.4 ms here)
         # Started by the same roslaunch as SLAM and move_base: a connection rospy lost while both
         # registered is made again during the start-up wait (topic_watch).
+        self.map_lock = threading.Lock()  # the whole map's and the updates' callbacks run in two threads
         if c.subscribe_to_updates:
-            rospy.Subscriber(map_topic + '_updates', numpy_msg(OccupancyGridUpdate), self.on_map_update, queue_size=10)
+            rospy.Subscriber(map_topic + '_updates', numpy_msg(OccupancyGridUpdate), self.on_map_update, queue_size=100)
         self.inputs = [WatchedSubscriber(map_topic, numpy_msg(OccupancyGrid), self.on_map, queue_size=1,
                                          buff_size=2 ** 24),
                        WatchedSubscriber(costmap_topic, numpy_msg(OccupancyGrid), self.on_costmap, queue_size=1,
@@ -394,20 +401,23 @@ class Explore:
         self.team_pub.publish(msg)
 
     def on_map(self, msg: OccupancyGrid) -> None:
-        self.map = grid_of(msg)
-        self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
+        with self.map_lock:  # not interleaved with an update's read-modify-write
+            self.map = grid_of(msg)
+            self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
 
     def on_map_update(self, msg: OccupancyGridUpdate) -> None:
         """A window of the map replaced (a new Grid: the explorer's loop may hold the old one)."""
-        m = patched_grid(self.map, msg)
+        with self.map_lock:
+            m = patched_grid(self.map, msg)
+            if m is not None:
+                self.map = m
+                self.map_with_stamp = (self.map, msg.header.stamp)
         if m is None:
             rospy.logwarn_throttle(10, 'explore: an update on %s_updates does not fit the map held; ignored until the '
                                    'next whole map' % rospy.resolve_name(self.map_topic))
             return
-        self.map = m
-        self.map_with_stamp = (self.map, msg.header.stamp)
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
 
