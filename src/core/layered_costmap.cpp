@@ -409,7 +409,10 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
       c.obstacle_layer = o;
     } else if (kind == "keepout" || kind == "speed") {
       c.filters.push_back(readFilter(layer_name, type, kind, lr));
-      if (&lr != &r) lr.ignored("plugin", "the filter's type (Nav2's key)");
+      if (&lr != &r) {
+        lr.ignored("plugin", "the filter's type (Nav2's key)");
+        lr.ignored("type", "the filter's type");
+      }
     } else {
       InflationLayerConfig f;
       const InflationLayerConfig d;

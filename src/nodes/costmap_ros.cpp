@@ -160,7 +160,9 @@ void CostmapROS::onMask(const nav_msgs::OccupancyGrid::ConstPtr& msg, std::size_
   std::string zones;
   {
     std::lock_guard<std::mutex> guard(mutex_);
-    for (const auto& z : layered_->filterMask(index).zoneNames()) zones += (zones.empty() ? "" : ", ") + z;
+    const auto& names = layered_->filterMask(index).zoneNames();
+    for (std::size_t k = 0; k < names.size() && k < 5; ++k) zones += (zones.empty() ? "" : ", ") + names[k];
+    if (names.size() > 5) zones += " and " + std::to_string(names.size() - 5) + " more";
   }
   ROS_INFO("%s: %s filter %s: a mask of %u x %u cells from %s; zones: %s", name_.c_str(),
            f.kind == core::FilterConfig::Kind::kSpeed ? "speed" : "keep-out", f.name.c_str(), info.width, info.height,

@@ -68,7 +68,7 @@ class MoveBaseZonesTest(unittest.TestCase):
     def test_2_the_robot_keeps_to_30_percent_in_the_speed_zone_and_not_outside(self):
         with self.lock:
             del self.samples[:]
-        for x, y, yaw in ((-4.2, -4.5, math.pi), (-1.0, -1.0, 0.0), (3.0, -4.8, 0.0)):  # the last in the kitchen
+        for x, y, yaw in ((-2.5, -3.0, math.pi), (3.0, -4.8, 0.0)):  # across the living room, then the kitchen
             state, text = self.go(x, y, yaw)
             self.assertEqual(state, GoalStatus.SUCCEEDED, text)
         with self.lock:
