@@ -96,6 +96,15 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
   return s;
 }
 
+/// A parameter that must be a list (`what` says of what, for the error).
+ParamValue readList(ParamReader& r, const std::string& key, const char* doc, const std::string& what) {
+  const ParamValue v = r.raw(key, ParamValue::ofList(), doc, "list");
+  if (v.type != ParamValue::Type::kList) {
+    throw ParamError("parameter " + r.where(key) + " must be a list of " + what + ", got " + v.repr());
+  }
+  return v;
+}
+
 ZonePolygon readPolygon(const ParamValue& item, const std::string& where) {
   ZonePolygon z;
   z.name = where;
@@ -128,13 +137,10 @@ FilterConfig readFilter(const std::string& name, const std::string& type, const 
   try {
     const bool speed = f.kind == FilterConfig::Kind::kSpeed;
     if (!speed) {
-      const ParamValue areas = lr.raw("prohibition_areas", ParamValue::ofList(),
-                                      "keep-out filter: zones as polygons in global_frame, [[[x, y], ...], ...] "
-                                      "(costmap_prohibition_layer's), or [{name: ..., points: [[x, y], ...]}, ...]",
-                                      "list");
-      if (areas.type != ParamValue::Type::kList) {
-        throw ParamError("parameter " + lr.where("prohibition_areas") + " must be a list of polygons, got " + areas.repr());
-      }
+      const ParamValue areas = readList(lr, "prohibition_areas",
+                                        "keep-out filter: zones as polygons in global_frame, [[[x, y], ...], ...] "
+                                        "(costmap_prohibition_layer's), or [{name: ..., points: [[x, y], ...]}, ...]",
+                                        "polygons");
       for (std::size_t i = 0; i < areas.items.size(); ++i) {
         f.zones.push_back(readPolygon(areas.items[i], lr.where("prohibition_areas") + "[" + std::to_string(i) + "]"));
       }
@@ -254,11 +260,15 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
   // Layers: (name, kind, reader of the layer's keys; the top-level reader for the pre-Hydro style).
   std::vector<std::tuple<std::string, std::string, std::unique_ptr<ParamReader>, std::string>> layers;
   std::set<std::string> sub_namespaces;
+  // A plugin's or filter's own reader, over its namespace <ns>/<name> (empty when not set).
+  auto layerReader = [&](const std::string& lname) {
+    const ParamValue* lv = r.values().get(lname);
+    sub_namespaces.insert(lname);
+    return std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
+                                         ns + "/" + lname, warn);
+  };
   if (r.has("plugins")) {
-    const ParamValue plugins = r.raw("plugins", ParamValue::ofList(), kPluginsDoc, "list");
-    if (plugins.type != ParamValue::Type::kList) {
-      throw ParamError("parameter " + r.where("plugins") + " must be a list of {name, type}, got " + plugins.repr());
-    }
+    const ParamValue plugins = readList(r, "plugins", kPluginsDoc, "{name, type}");
     for (std::size_t i = 0; i < plugins.items.size(); ++i) {
       const ParamValue& p = plugins.items[i];
       const ParamValue* pname = p.get("name");
@@ -275,12 +285,7 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
         throw ParamError(at + ": unknown layer type \"" + ptype->s + "\"" + (guess.empty() ? "" : " (did you mean " + guess + "?)") +
                          "; known: " + known);
       }
-      const ParamValue* lv = r.values().get(pname->s);
-      sub_namespaces.insert(pname->s);
-      layers.emplace_back(pname->s, kind->second,
-                          std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
-                                                        ns + "/" + pname->s, warn),
-                          ptype->s);
+      layers.emplace_back(pname->s, kind->second, layerReader(pname->s), ptype->s);
     }
   } else {
     // Pre-Hydro: the layers ROS builds from the old keys, which live at the top level.
@@ -296,13 +301,10 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
     layers.emplace_back("inflation_layer", "inflation", nullptr, "costmap_2d::InflationLayer");
   }
   // Nav2's filters list: [{name: ..., type: ...}] or [name, ...] with <name>/plugin.
-  const ParamValue filters = r.raw("filters", ParamValue::ofList(),
-                                   "costmap filters, [{name: ..., type: nav2_costmap_2d::KeepoutFilter}, ...] "
-                                   "(KeepoutFilter, SpeedFilter, CostmapProhibitionLayer); with either style",
-                                   "list");
-  if (filters.type != ParamValue::Type::kList) {
-    throw ParamError("parameter " + r.where("filters") + " must be a list of {name, type}, got " + filters.repr());
-  }
+  const ParamValue filters = readList(r, "filters",
+                                     "costmap filters, [{name: ..., type: nav2_costmap_2d::KeepoutFilter}, ...] "
+                                     "(KeepoutFilter, SpeedFilter, CostmapProhibitionLayer); with either style",
+                                     "{name, type}");
   for (std::size_t i = 0; i < filters.items.size(); ++i) {
     const ParamValue& p = filters.items[i];
     const std::string at = "parameter " + r.where("filters") + "[" + std::to_string(i) + "]";
@@ -326,12 +328,7 @@ CostmapConfig readCostmapConfig(const std::string& name, const ParamValue& value
       throw ParamError(at + ": \"" + ftype + "\" is not a filter; known: nav2_costmap_2d::KeepoutFilter, "
                        "nav2_costmap_2d::SpeedFilter, " + kProhibitionType);
     }
-    const ParamValue* lv = r.values().get(fname);
-    sub_namespaces.insert(fname);
-    layers.emplace_back(fname, kind->second,
-                        std::make_unique<ParamReader>(lv && lv->type == ParamValue::Type::kMap ? *lv : ParamValue::ofMap(),
-                                                      ns + "/" + fname, warn),
-                        ftype);
+    layers.emplace_back(fname, kind->second, layerReader(fname), ftype);
   }
   for (auto& [layer_name, kind, reader, type] : layers) {
     ParamReader& lr = reader ? *reader : r;

@@ -9,26 +9,20 @@ import unittest
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus
-from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 from visualization_msgs.msg import Marker
 
 from mbot_slam_navigation.msg import FollowWaypointsAction, FollowWaypointsGoal
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
-from mbot_slam_navigation.transforms import yaw_to_quaternion
+
+from test_move_base_home import goal_msg
 
 POSES = [(-1.5, -2.0, -math.pi / 2), (-0.5, -3.5, 0.0), (-2.5, -3.0, math.pi), (-3.8, 0.9, 0.0)]  # the last in a wall
 REACHABLE = 3
 
 
 def pose_stamped(x, y, yaw):
-    p = PoseStamped()
-    p.header.frame_id = 'map'
-    p.pose.position.x, p.pose.position.y = x, y
-    q = yaw_to_quaternion(yaw)
-    o = p.pose.orientation
-    o.x, o.y, o.z, o.w = q
-    return p
+    return goal_msg(x, y, yaw).target_pose  # in map
 
 
 class FollowWaypointsTest(unittest.TestCase):
