@@ -107,6 +107,11 @@ int ringCost(const Costmap& map, double x, double y, double radius, bool unknown
 }
 }  // namespace
 
+double contactRadius(const Footprint& footprint) {
+  const double round = roundRadius(footprint);
+  return round > 0.0 ? round : inscribedRadius(footprint);
+}
+
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle) {
   const double round = roundRadius(footprint);
   if (round > 0.0) return ringCost(map, pose.x(), pose.y(), round, unknown_is_obstacle);

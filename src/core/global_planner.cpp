@@ -5,6 +5,8 @@
 #include <limits>
 #include <queue>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace mbot {
@@ -101,9 +103,15 @@ const char* toString(PlanStatus s) {
   return "?";
 }
 
-GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) {
+GlobalPlanner::GlobalPlanner(const PlannerParams& params) : params_(params) { setLethalCost(params.lethal_cost); }
+
+void GlobalPlanner::setLethalCost(int lethal_cost) {
+  if (lethal_cost < 1 || lethal_cost > cost::kInscribed) {
+    throw std::invalid_argument("lethal_cost must be in 1..253, got " + std::to_string(lethal_cost));
+  }
+  params_.lethal_cost = lethal_cost;
   for (int v = 0; v < 256; ++v) {
-    if (v < cost::kInscribed) cost_of_value_[v] = static_cast<float>(params_.neutral_cost + params_.cost_factor * v);
+    if (v < params_.lethal_cost) cost_of_value_[v] = static_cast<float>(params_.neutral_cost + params_.cost_factor * v);
     else if (v == cost::kNoInformation && params_.allow_unknown) cost_of_value_[v] = static_cast<float>(cost::kInscribed);
     else cost_of_value_[v] = kInf;
   }
@@ -144,13 +152,16 @@ Plan GlobalPlanner::makePlan(const Costmap& map, const Eigen::Vector2d& start_m,
   const int start = static_cast<int>(map.index(s));
   start_ = start;
   // The robot's own cell is passable even when inscribed (navfn clears the robot cell), and so are
-  // the inscribed cells near an inscribed start (kStartEscape_m), at the highest passable cost.
+  // the blocked cells near a blocked start (kStartEscape_m), at the highest passable cost.
   start_cost_ = static_cast<float>(params_.neutral_cost);
   map_width_ = map.width();
   start_x_ = s.x;
   start_y_ = s.y;
-  escape_cells_ = map.cost(s) == cost::kInscribed ? static_cast<int>(std::ceil(kStartEscape_m / map.resolution())) : 0;
-  escape_cost_ = cost_of_value_[cost::kInscribed - 1];
+  const uint8_t start_value = map.cost(s);
+  escape_cells_ = start_value >= params_.lethal_cost && start_value <= cost::kInscribed
+                      ? static_cast<int>(std::ceil(kStartEscape_m / map.resolution()))
+                      : 0;
+  escape_cost_ = cost_of_value_[params_.lethal_cost - 1];
 
   int goal = static_cast<int>(map.index(g));
   if (!std::isfinite(cellCost(goal))) {

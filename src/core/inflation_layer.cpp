@@ -22,6 +22,19 @@ uint8_t inflatedCost(double d, const InflationParams& p) {
   return static_cast<uint8_t>((cost::kInscribed - 1) * std::exp(-p.cost_scaling_factor * (d - p.inscribed_radius)));
 }
 
+uint8_t contactCost(const InflationParams& p, double resolution, double contact_radius) {
+  const double reach = contact_radius / resolution;  // [cells]
+  double farthest = 0.0;                             // [cells] centre distance of the farthest touching cell
+  for (int dx = 0; dx <= static_cast<int>(reach) + 1; ++dx) {
+    for (int dy = 0; dy <= dx; ++dy) {
+      const double gap = std::hypot(std::max(dx - 0.5, 0.0), std::max(dy - 0.5, 0.0));  // to the cell's square
+      if (gap < reach) farthest = std::max(farthest, std::hypot(dx, dy));
+    }
+  }
+  const uint8_t c = inflatedCost(farthest * resolution, p);
+  return c == cost::kFree || c > cost::kInscribed ? cost::kInscribed : c;
+}
+
 CellWindow CellWindow::unite(const CellWindow& o) const {
   if (empty()) return o;
   if (o.empty()) return *this;

@@ -821,6 +821,12 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
   return window;
 }
 
+uint8_t LayeredCostmap::contactCost() const {
+  return config_.inflation_layer && config_.inflation_layer->enabled
+             ? core::contactCost(inflation_, master_.resolution(), contactRadius(config_.footprint))
+             : cost::kInscribed;
+}
+
 void LayeredCostmap::resetObstacles(const std::optional<Eigen::Vector3d>& keep) {
   const Costmap old = obstacle_;
   obstacle_.fill(obstacle_default_);

@@ -19,6 +19,10 @@ constexpr double kSpinSpot_m = 0.05;  // moving less than this counts as turning
 // cells (0.05 m in sim_time): their costs tie, the straight one wins, and the robot crept on at
 // min_vel_x while the plan turned away (in the home, about 5 s more over 75-90 m of goals, measured).
 constexpr double kFacingAway_rad = M_PI / 3.0;
+// [m] Turning on the spot aims at the plan this far ahead of the robot's nearest plan point: far
+// enough that the cells' 45-degree steps average out, near enough to be the way out of where it
+// stands.
+constexpr double kTurnLookahead_m = 0.5;
 
 bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
 
@@ -644,7 +648,18 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     return map.contains(ahead) ? static_cast<double>(goal_grid_.at(ahead)) : std::numeric_limits<double>::infinity();
   };
 
-  // Rotating in place, towards where the goal distance a heading_lookahead ahead is smallest.
+  // Rotating in place: towards the plan kTurnLookahead_m ahead (the rotation that ends facing it
+  // most nearly), or, without a plan in sight, towards where the goal distance a heading_lookahead
+  // ahead is smallest (ROS's rule). ROS's rule alone compares the goal distances of cells beside
+  // the robot, which around obstacles can favour turning away from the plan; the oscillation flags
+  // then forbid turning back, and the robot turned a full circle before it could follow the plan.
+  Eigen::Vector2d turn_to;
+  const bool aim = planAhead(pose.head<2>(), kTurnLookahead_m, &turn_to) && (turn_to - pose.head<2>()).norm() > 2.0 * map.resolution();
+  auto turnScore = [&](const Trajectory& t) {
+    if (!aim || t.points.empty()) return goalDistanceAhead(t);
+    const Eigen::Vector3d& e = t.points.back();
+    return std::abs(normalizeAngle(std::atan2(turn_to.y() - e.y(), turn_to.x() - e.x()) - e.z()));
+  };
   double heading_dist = std::numeric_limits<double>::max();
   double vth_samp = min_vth;
   for (int i = 0; i < p.vtheta_samples && (!progressing || facing_away); ++i) {
@@ -653,7 +668,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
              facing_away ? std::numeric_limits<double>::infinity() : bar());  // exact: it may win on heading alone
     if (comp.cost >= 0 && (facing_away || comp.cost <= best.cost || best.cost < 0 || best.yv != 0.0) &&
         std::abs(vth_samp) > dvth) {
-      const double d = goalDistanceAhead(comp);
+      const double d = turnScore(comp);
       if (d < heading_dist && ((vth_samp < 0 && !stuck_left_) || (vth_samp > 0 && !stuck_right_))) {
         std::swap(best, comp);
         heading_dist = d;

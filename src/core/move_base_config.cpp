@@ -99,8 +99,17 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
   c.planner.allow_unknown = g.boolean("allow_unknown", c.planner.allow_unknown, "plans may cross unknown cells");
   c.planner.default_tolerance = g.number("default_tolerance", c.planner.default_tolerance,
                                          "[m] plan to the nearest free cell within this of a blocked goal", 0.0);
+  c.planner.lethal_cost = static_cast<int>(
+      g.integer("lethal_cost", 0,
+                "cells at this cost or above are obstacles to the plan (global_planner's key, 1..253); 0: the global "
+                "costmap's contact cost, below which the robot's footprint stays clear of lethal cells (253 when its "
+                "inflation cannot tell), so that the local planner can follow every plan",
+                0));
+  if (c.planner.lethal_cost > cost::kInscribed) {
+    throw ParamError("parameter " + g.where("lethal_cost") + " must be in 0..253, got " + std::to_string(c.planner.lethal_cost));
+  }
   for (const char* key : {"visualize_potential", "planner_window_x", "planner_window_y", "planner_costmap_publish_frequency",
-                          "use_quadratic", "use_grid_path", "old_navfn_behavior", "lethal_cost", "neutral_cost", "cost_factor",
+                          "use_quadratic", "use_grid_path", "old_navfn_behavior", "neutral_cost", "cost_factor",
                           "publish_potential", "orientation_mode", "orientation_window_size", "outline_map"}) {
     g.ignored(key, "a key of navfn or global_planner that this planner does not need");
   }

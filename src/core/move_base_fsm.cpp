@@ -36,7 +36,7 @@ double remainingPath(const std::vector<Eigen::Vector2d>& plan, const Eigen::Vect
 }
 
 bool planBlocked(const Costmap& costmap, const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector2d& position,
-                 double skip_m) {
+                 double skip_m, int lethal_cost) {
   if (plan.empty()) return false;
   std::size_t nearest = 0;
   for (std::size_t i = 1; i < plan.size(); ++i) {
@@ -47,7 +47,7 @@ bool planBlocked(const Costmap& costmap, const std::vector<Eigen::Vector2d>& pla
     const Cell c = costmap.worldToCell(plan[i]);
     if (!costmap.contains(c)) continue;
     const uint8_t v = costmap.cost(c);
-    if (v >= cost::kInscribed && v != cost::kNoInformation) return true;
+    if (v >= lethal_cost && v != cost::kNoInformation) return true;
   }
   return false;
 }

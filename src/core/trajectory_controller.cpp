@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 namespace mbot {
@@ -10,7 +11,23 @@ namespace core {
 namespace {
 constexpr double kStoppedTrans = 1e-2;  // [m/s] ROS's trans_stopped_velocity
 constexpr double kStoppedRot = 1e-2;    // [rad/s] rot_stopped_velocity
+// [m] A new plan whose first kNewWayAlong_m strays farther than kNewWayOff_m from the old one
+// takes another way.
+constexpr double kNewWayAlong_m = 1.0, kNewWayOff_m = 0.2;
 double sign(double v) { return v >= 0.0 ? 1.0 : -1.0; }
+
+/// Whether `next` starts another way than `prev` (an empty `prev` included).
+bool anotherWay(const std::vector<Eigen::Vector2d>& prev, const std::vector<Eigen::Vector2d>& next) {
+  if (prev.empty() || next.empty()) return !next.empty();
+  double along = 0.0;
+  for (std::size_t i = 0; i < next.size() && along <= kNewWayAlong_m; ++i) {
+    if (i > 0) along += (next[i] - next[i - 1]).norm();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector2d& q : prev) nearest = std::min(nearest, (q - next[i]).squaredNorm());
+    if (nearest > kNewWayOff_m * kNewWayOff_m) return true;
+  }
+  return false;
+}
 double normalizeAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 std::string g(double v) {
   char buf[64];
@@ -157,6 +174,14 @@ TrajectoryController::TrajectoryController(const LocalPlannerParams& params, con
     : planner_(params, footprint), ros_(ros) {}
 
 void TrajectoryController::setPlan(const std::vector<Eigen::Vector2d>& plan, double goal_yaw) {
+  // A new plan ends escape mode: the plan was made on what the robot saw after it backed out, and
+  // it passes where the robot fits (lethal_cost). Kept, the escape allowed only turning on the
+  // spot until a quarter turn, and the turning side then forbade turning back: in clutter, a full
+  // circle before the robot could follow the plan (ROS keeps it). A plan along another way (an
+  // obstacle found on the old one) also clears the sides the robot turned to without moving: they
+  // were learnt on the old way.
+  if (anotherWay(plan_, plan)) planner_.resetOscillation();
+  else planner_.resetEscape();
   plan_ = plan;
   goal_yaw_ = goal_yaw;
   reached_ = false;

@@ -60,6 +60,8 @@ class CostmapROS {
   /// The grid, valid while the lock is held.
   std::unique_lock<std::mutex> lock() { return std::unique_lock<std::mutex>(mutex_); }
   const core::Costmap& master() const { return layered_->master(); }
+  /// LayeredCostmap::contactCost, for the map's current resolution (valid while the lock is held).
+  uint8_t contactCost() const { return layered_->contactCost(); }
 
  private:
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);

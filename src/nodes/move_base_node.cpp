@@ -100,6 +100,9 @@ class MoveBase {
     config_ = core::readMoveBaseConfig(ros_glue::fromXmlRpc(values), ros::this_node::getName(),
                                        [](const std::string& t) { ROS_WARN("%s", t.c_str()); },
                                        local_->config().circumscribed_radius);
+    // lethal_cost 0: the global costmap's contact cost, set before each plan (it follows the map's resolution).
+    auto_lethal_cost_ = config_.planner.lethal_cost == 0;
+    if (auto_lethal_cost_) config_.planner.lethal_cost = core::cost::kInscribed;
     planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);
     service_planner_ = std::make_unique<core::GlobalPlanner>(config_.planner);  // ~make_plan, not racing the loop
     controller_ = std::make_unique<core::TrajectoryController>(config_.local, config_.local_ros, local_->config().footprint);
@@ -204,6 +207,7 @@ class MoveBase {
     core::Plan p;
     {
       auto guard = global_->lock();
+      planner.setLethalCost(lethalCost());
       p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
       resolution = global_->master().resolution();
     }
@@ -386,7 +390,8 @@ class MoveBase {
     bool planBlocked(const Path2& path, const Vec3& pose) override {
       auto guard = mb_.global_->lock();
       const auto& map = mb_.global_->master();
-      return core::planBlocked(map, path, pose.head<2>(), mb_.global_->config().circumscribed_radius + map.resolution());
+      return core::planBlocked(map, path, pose.head<2>(), mb_.global_->config().circumscribed_radius + map.resolution(),
+                               mb_.lethalCost());
     }
     void planMade(const Path2& path, double goal_yaw) override {
       mb_.publishPath({&mb_.plan_pub_, &mb_.generic_plan_pub_}, path, mb_.global_->config().global_frame, goal_yaw);
@@ -669,6 +674,9 @@ class MoveBase {
   std::unique_ptr<ros_glue::CostmapROS> global_, local_;
   core::MoveBaseConfig config_;
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
+  bool auto_lethal_cost_ = true;
+  /// The global planner's lethal_cost (the global costmap's lock held).
+  int lethalCost() const { return auto_lethal_cost_ ? global_->contactCost() : config_.planner.lethal_cost; }
   std::unique_ptr<core::TrajectoryController> controller_;
   std::string speed_zone_;  // the speed zone the robot is in ("" none), for saying so once
   std::mutex velocity_mutex_, service_mutex_;

@@ -209,6 +209,43 @@ TEST(Footprint, ARoundRobotCostsTheSameAtEveryHeading) {
   EXPECT_LT(clear, 19 * 31);
 }
 
+TEST(Inflation, AFootprintCentredBelowTheContactCostNeverTouchesALethalCell) {
+  // What the global planner (lethal_cost) and the local planner (footprintCost) must agree on: a
+  // centre the plan may cross is one where the footprint is clear. The inscribed cost (253) alone
+  // is not enough: a lethal cell whose centre is farther than the inscribed radius can still reach
+  // into the footprint, and a plan through such cells is one the local planner cannot follow.
+  // A round footprint (robot_radius), clear at every heading; a polygon's corners reach farther
+  // than its inscribed circle, and whether they touch depends on the heading: that is the local
+  // planner's to find.
+  for (const Footprint& fp : {padFootprint(circleFootprint(0.2), 0.01), padFootprint(circleFootprint(0.3), 0.0)}) {
+    InflationParams p;
+    p.inscribed_radius = inscribedRadius(fp);
+    p.inflation_radius = 0.6;
+    p.cost_scaling_factor = 10.0;
+    const uint8_t contact = contactCost(p, 0.05, contactRadius(fp));
+    ASSERT_LT(contact, cost::kInscribed) << "the contact band lies outside the inscribed one";
+    int touching_below_inscribed = 0;
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+      std::srand(seed);
+      Costmap m(80, 80, 0.05, {0, 0});
+      for (int k = 0; k < 40; ++k) m.setCost({10 + std::rand() % 60, 10 + std::rand() % 60}, cost::kLethal);
+      inflate(m, p);
+      for (int y = 10; y < 70; ++y) {
+        for (int x = 10; x < 70; ++x) {
+          const uint8_t c = m.cost({x, y});
+          const Eigen::Vector2d centre = m.cellCenter({x, y});
+          for (double yaw : {0.0, 0.4, M_PI / 4, 1.2}) {
+            const bool clear = footprintCost(m, {centre.x(), centre.y(), yaw}, fp) >= 0;
+            if (c < contact) ASSERT_TRUE(clear) << "cost " << int(c) << " below the contact cost " << int(contact) << " at " << x << ", " << y;
+            if (c >= contact && c < cost::kInscribed && !clear) ++touching_below_inscribed;
+          }
+        }
+      }
+    }
+    EXPECT_GT(touching_below_inscribed, 0) << "no cell below 253 touched: the test shows nothing";
+  }
+}
+
 #include "mbot_slam_navigation/core/obstacle_layer.h"
 
 namespace {

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdlib>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -95,6 +96,35 @@ TEST_P(BothPlanners, AStartInAnInscribedPocketLeavesItButNeverCrossesAWall) {
   // Away from the start the inscribed band still blocks: no goal inside it far along the wall.
   const Plan along = planner.makePlan(m, {0.5, 0.5}, {1.4, 2.9});
   EXPECT_NE(along.status, PlanStatus::kOk);
+}
+
+TEST_P(BothPlanners, CellsAtLethalCostOrAboveAreObstacles) {
+  // global_planner's lethal_cost: a gap whose cells cost 230 is crossed at the default (253) and
+  // avoided at 220 (move_base sets it to the costmap's contact cost).
+  Costmap m(40, 20, 0.1, {0, 0});
+  for (int y = 0; y < 20; ++y) m.setCost({20, y}, cost::kLethal);  // a wall at x = 2.0 m
+  for (int y = 9; y <= 10; ++y) m.setCost({20, y}, 230);            // a gap in its middle
+  m.setCost({20, 19}, 0);                                            // and a way round at the top
+  PlannerParams p;
+  p.use_astar = GetParam();
+  GlobalPlanner planner(p);
+  auto throughGap = [&](const Plan& plan) {
+    for (const auto& q : plan.path) {
+      const Cell c = m.worldToCell(q);
+      if (c.x == 20 && (c.y == 9 || c.y == 10)) return true;
+    }
+    return false;
+  };
+  const Plan direct = planner.makePlan(m, {0.55, 0.95}, {3.55, 0.95});
+  ASSERT_EQ(direct.status, PlanStatus::kOk) << direct.message;
+  EXPECT_TRUE(throughGap(direct));
+  planner.setLethalCost(220);
+  const Plan around = planner.makePlan(m, {0.55, 0.95}, {3.55, 0.95});
+  ASSERT_EQ(around.status, PlanStatus::kOk) << around.message;
+  EXPECT_FALSE(throughGap(around));
+  for (const auto& q : around.path) EXPECT_LT(m.cost(m.worldToCell(q)), 220);
+  EXPECT_THROW(planner.setLethalCost(0), std::invalid_argument);
+  EXPECT_THROW(planner.setLethalCost(254), std::invalid_argument);
 }
 
 TEST_P(BothPlanners, GoalInAWallMovesWithinTheTolerance) {

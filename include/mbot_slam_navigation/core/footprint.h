@@ -22,6 +22,9 @@ Footprint padFootprint(const Footprint& footprint, double padding_m);
 /// Distance [m] from the origin to the nearest edge / farthest vertex.
 double inscribedRadius(const Footprint& footprint);
 double circumscribedRadius(const Footprint& footprint);
+/// [m] A lethal cell nearer than this to the centre is a collision at every heading: the circle's
+/// radius for a round footprint (footprintCost checks it as that circle), else the inscribed radius.
+double contactRadius(const Footprint& footprint);
 /// Throws std::invalid_argument when the polygon has fewer than 3 vertices or does not contain
 /// the origin (the robot's centre must lie inside its footprint).
 void validateFootprint(const Footprint& footprint);

@@ -1,8 +1,10 @@
 // Global planning on a costmap, as navfn does it and with an A* option.
 //
 // Every traversable cell costs neutral_cost + cost_factor * its costmap value (navfn: 50 + 0.8 c);
-// cells at 253 (inscribed) or 254 (lethal) are obstacles, 255 (unknown) costs 253 when
-// allow_unknown and is an obstacle otherwise.
+// cells at lethal_cost or above (global_planner's parameter; 253, inscribed, by default) are
+// obstacles, 255 (unknown) costs 253 when allow_unknown and is an obstacle otherwise. move_base sets
+// lethal_cost to the costmap's contactCost: a centre nearer a lethal cell than that is one where the
+// local planner's footprint already covers the lethal cell, so a plan through it cannot be followed.
 // - Dijkstra (use_astar false): navfn's wavefront from the goal with its quadratic potential update
 //   (the potential at a cell interpolates between its two smallest 4-neighbours, approximating the
 //   continuous distance field), stopped once the start is reached; the path descends the potential
@@ -45,6 +47,8 @@ struct PlannerParams {
   double default_tolerance = 0.0;  ///< [m] a blocked goal moves to the nearest free cell this close
   double neutral_cost = 50.0;
   double cost_factor = 0.8;
+  /// Cells at this cost or above are obstacles (global_planner's `lethal_cost`, 1..253).
+  int lethal_cost = cost::kInscribed;
   /// false: the searches of before (the whole wavefront / euclidean A*, a binary heap, no coarse
   /// level), a reference for benchmarks and tests; the paths are the same up to ties.
   bool use_bounds = true;
@@ -63,6 +67,8 @@ class GlobalPlanner {
  public:
   explicit GlobalPlanner(const PlannerParams& params = PlannerParams());
   const PlannerParams& params() const { return params_; }
+  /// Another lethal_cost (1..253) for the next plans.
+  void setLethalCost(int lethal_cost);
   /// Plans on `map` (start and goal in its frame, m). Work is proportional to the cells the search
   /// touches, not to the map: buffers persist between calls and are invalidated by a generation
   /// stamp instead of being cleared (navfn copies and clears the whole costmap on every call).
@@ -77,8 +83,9 @@ class GlobalPlanner {
     if (i == start_) return start_cost_;
     const uint8_t c = (*costs_)[i];
     const float v = cost_of_value_[c];
-    // A robot whose centre stands in an inscribed cell may leave through the inscribed cells around it.
-    if (escape_cells_ > 0 && c == cost::kInscribed && v == kUnreached) {
+    // A robot whose centre stands in a blocked cell (at lethal_cost or above, not lethal) may leave
+    // through the blocked cells around it.
+    if (escape_cells_ > 0 && c >= params_.lethal_cost && c <= cost::kInscribed && v == kUnreached) {
       const int dx = i % map_width_ - start_x_, dy = i / map_width_ - start_y_;
       if (dx * dx + dy * dy <= escape_cells_ * escape_cells_) return escape_cost_;
     }
@@ -112,8 +119,8 @@ class GlobalPlanner {
 
  public:
   static constexpr int kBlock = 4;            ///< [cells] side of a coarse block
-  /// [m] A start in an inscribed cell (a robot the costmap puts against a wall end or a person who
-  /// walked up to it) may leave through inscribed cells this close to it; navfn clears only the
+  /// [m] A start in a blocked cell (a robot the costmap puts against a wall end or a person who
+  /// walked up to it) may leave through blocked cells this close to it; navfn clears only the
   /// robot's own cell and then finds no way out of such a pocket.
   static constexpr double kStartEscape_m = 0.3;
   static constexpr int kCorridorRadius = 3;   ///< [blocks] around the coarse way
@@ -123,7 +130,7 @@ class GlobalPlanner {
   float cost_of_value_[256];
   float start_cost_ = 0.0f;
   int start_ = -1;
-  // The start's inscribed surroundings (kStartEscape_m), passable only when the start is inscribed.
+  // The start's blocked surroundings (kStartEscape_m), passable only when the start is blocked.
   int escape_cells_ = 0, start_x_ = 0, start_y_ = 0, map_width_ = 1;
   float escape_cost_ = 0.0f;
   const std::vector<uint8_t>* costs_ = nullptr;

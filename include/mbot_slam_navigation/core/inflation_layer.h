@@ -26,6 +26,15 @@ struct InflationParams {
 /// The cost at distance d [m] from an obstacle.
 uint8_t inflatedCost(double distance_m, const InflationParams& params);
 
+/// The lowest cost at which a footprint centred on a cell may touch a lethal cell of `resolution`
+/// [m], for a footprint that touches every lethal cell (a square) nearer than `contact_radius` [m]
+/// to its centre (contactRadius). Costs follow cell-centre distances, and a lethal cell whose
+/// centre is more than inscribed_radius away may still reach into the footprint: the inscribed
+/// cost (253) alone lets a planner put the centre where the local planner's footprint check fails.
+/// It is the cost at the largest cell-centre distance of a cell that can touch; 253 when that
+/// lies beyond inflation_radius (the costs cannot tell it apart) or the footprint is a point.
+uint8_t contactCost(const InflationParams& params, double resolution, double contact_radius);
+
 /// A cell window [x0, x1) x [y0, y1) of a costmap (costmap_2d's update bounds, in cells).
 struct CellWindow {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;

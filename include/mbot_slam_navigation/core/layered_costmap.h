@@ -131,6 +131,9 @@ class LayeredCostmap {
   void resetObstacles(const std::optional<Eigen::Vector3d>& keep = std::nullopt);
 
   const Costmap& master() const { return master_; }
+  /// contactCost of this costmap's footprint, inflation and resolution: the lowest cost at which a
+  /// centre's footprint may cover a lethal cell (253 without an inflation layer).
+  uint8_t contactCost() const;
 
   /// A mask for filter `index` of config().filters (OccupancyGrid data, as setMap). Throws
   /// std::invalid_argument saying why when it cannot be used (its size, or a resolution other

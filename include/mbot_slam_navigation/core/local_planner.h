@@ -154,6 +154,8 @@ class LocalPlanner {
   double speedLimit() const { return speed_limit_; }
   /// Clears the oscillation and escape state (a new goal).
   void resetOscillation();
+  /// Ends escape mode (the robot may drive forward again at once).
+  void resetEscape() { escaping_ = false; }
   /// false: score every footprint by its full outline walk (the reference the shortcuts must
   /// match exactly; for tests and benchmarks).
   void setShortcuts(bool on) { shortcuts_ = on; }

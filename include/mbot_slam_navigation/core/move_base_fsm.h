@@ -117,11 +117,11 @@ double remainingPath(const std::vector<Eigen::Vector2d>& plan, const Eigen::Vect
 class Costmap;
 /// Whether `plan`, from its point nearest `position` on and leaving out the points within `skip_m`
 /// [m] of it and of the plan's end (the robot may stand in an inflated zone, the goal may lie in
-/// one: the planner allows both), crosses a cell of `costmap` at or above
-/// the inscribed cost (the robot cannot pass there). Unknown cells and points off the costmap do
-/// not block (the planners cross unknown space).
+/// one: the planner allows both), crosses a lethal cell or one at or above `lethal_cost` (the
+/// global planner's: the robot cannot pass there). Unknown cells and points off the costmap do not
+/// block (the planners cross unknown space).
 bool planBlocked(const Costmap& costmap, const std::vector<Eigen::Vector2d>& plan, const Eigen::Vector2d& position,
-                 double skip_m);
+                 double skip_m, int lethal_cost = 253);
 
 }  // namespace core
 }  // namespace mbot
