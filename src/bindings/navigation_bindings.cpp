@@ -276,6 +276,7 @@ void bindNavigation(py::module& m) {
       .def_readonly("global_ns", &MoveBaseConfig::global_ns)
       .def_readonly("local_ns", &MoveBaseConfig::local_ns)
       .def_property_readonly("use_astar", [](const MoveBaseConfig& c) { return c.planner.use_astar; })
+      .def_property_readonly("lethal_cost", [](const MoveBaseConfig& c) { return c.planner.lethal_cost; })
       .def_readonly("local", &MoveBaseConfig::local)
       .def_readonly("recoveries", &MoveBaseConfig::recoveries);
   m.def("read_move_base_config", [](py::object values, const std::string& ns, py::object warn, double circumscribed) {

@@ -104,6 +104,19 @@ bool DistanceGrid::setLocalGoal(const Costmap& map, const std::vector<Eigen::Vec
   return true;
 }
 
+void DistanceGrid::setSources(const Costmap& map, const std::vector<Cell>& cells) {
+  std::vector<int> queue;
+  for (const Cell& c : cells) {
+    if (!map.contains(c)) continue;
+    const int i = static_cast<int>(map.index(c));
+    if (target_[i]) continue;
+    target_[i] = 1;
+    dist_[i] = 0.0f;
+    queue.push_back(i);
+  }
+  propagate(map, queue);
+}
+
 void DistanceGrid::propagate(const Costmap& map, std::vector<int>& queue) {
   // Breadth first from all targets at once: every step costs 1, so FIFO order is distance order.
   const int w = map.width(), h = map.height();
@@ -276,7 +289,6 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
   path_grid_.markWithinRobot(robot);
   goal_grid_.markWithinRobot(robot);  // ROS marks only the path map; the goal map needs it as much
   path_grid_.setPath(map, plan_);
-  goal_grid_.setLocalGoal(map, plan_, &local_goal_);
   dense_plan_.clear();
   dense_reach_ = 2.0 * map.resolution();
   for (const Eigen::Vector2d& p : densifyPlan(plan_, map.resolution())) {
@@ -285,6 +297,31 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
       continue;
     }
     dense_plan_.push_back(p);
+  }
+  // The local goal: the last plan point in the map that the robot can reach through the local
+  // costmap. ROS takes the last one in the map whatever stands between: where the local costmap
+  // sees an obstacle the global one does not yet (its inflation at the map's edge, a gap that has
+  // just closed), no cell around the robot had a goal distance, every trajectory was invalid, and
+  // move_base planned the same plan again every cycle with the robot stopped. A robot that can
+  // reach no plan point beyond its own cells (boxed in) keeps ROS's local goal, and no command.
+  reach_grid_.reset(map);
+  reach_grid_.markWithinRobot(robot);
+  reach_grid_.setSources(map, robot);
+  std::size_t reachable = dense_plan_.size();
+  for (std::size_t i = dense_plan_.size(); i-- > 0;) {
+    if (reach_grid_.at(map.worldToCell(dense_plan_[i])) < reach_grid_.obstacle()) {
+      reachable = i;
+      break;
+    }
+  }
+  // Only the robot's own cells reached, and the plan goes on: boxed in.
+  if (reachable + 1 < dense_plan_.size() && reach_grid_.at(map.worldToCell(dense_plan_[reachable])) < 1.0) {
+    reachable = dense_plan_.size();
+  }
+  if (reachable < dense_plan_.size()) {
+    goal_grid_.setLocalGoal(map, std::vector<Eigen::Vector2d>(dense_plan_.begin(), dense_plan_.begin() + reachable + 1), &local_goal_);
+  } else {
+    goal_grid_.setLocalGoal(map, plan_, &local_goal_);
   }
 }
 

@@ -242,6 +242,11 @@ def test_move_base_parameters_and_recoveries():
     assert any('controller_patiente (did you mean controller_patience?)' in w for w in warnings)
     with pytest.raises(ParamError, match=r'unknown planner "navfn/NavFnROS" \(did you mean navfn/NavfnROS\?\)'):
         _core.read_move_base_config({'base_global_planner': 'navfn/NavFnROS'}, '/move_base', None, 0.25)
+    assert c.lethal_cost == 0, 'the global costmap contact cost unless set'
+    assert _core.read_move_base_config({'NavfnROS': {'lethal_cost': 253}}, '/move_base', None, 0.25).lethal_cost == 253
+    with pytest.raises(ParamError, match=r'/move_base/GlobalPlanner/lethal_cost must be in 0..253, got 300'):
+        _core.read_move_base_config({'base_global_planner': 'global_planner/GlobalPlanner', 'GlobalPlanner': {'lethal_cost': 300}},
+                                    '/move_base', None, 0.25)
     with pytest.raises(ParamError, match=r'unknown recovery type "rotate_recovery/RotateRecovry"'):
         _core.read_move_base_config({'recovery_behaviors': [{'name': 'r', 'type': 'rotate_recovery/RotateRecovry'}]},
                                     '/move_base', None, 0.25)

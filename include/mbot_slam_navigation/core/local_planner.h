@@ -92,6 +92,8 @@ class DistanceGrid {
   /// Targets the last plan point of the first stretch inside the map (the local goal).
   bool setLocalGoal(const Costmap& map, const std::vector<Eigen::Vector2d>& plan, Eigen::Vector2d* local_goal = nullptr);
   void markWithinRobot(const std::vector<Cell>& cells);
+  /// Targets `cells` (the robot's own): the distances then say what the robot can reach.
+  void setSources(const Costmap& map, const std::vector<Cell>& cells);
   double at(const Cell& c) const { return dist_[static_cast<std::size_t>(c.y) * width_ + c.x]; }
   double obstacle() const { return static_cast<double>(dist_.size()); }
   double unreachable() const { return static_cast<double>(dist_.size()) + 1.0; }
@@ -194,6 +196,7 @@ class LocalPlanner {
   Eigen::Vector2d final_goal_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d local_goal_ = Eigen::Vector2d::Zero();
   DistanceGrid path_grid_, goal_grid_;
+  DistanceGrid reach_grid_;  // from the robot's cells: which plan points it can reach
   // Summed-area table of cells with a non-zero cost, (w + 1) x (h + 1); valid only inside
   // findBestPath, for the map it was called with.
   std::vector<int> nonzero_, blocking_;  // blocking_: cells that are lethal or unknown
