@@ -201,16 +201,33 @@ class MoveBase {
   }
 
   // --- planning -------------------------------------------------------------------------------------
-  /// Plans on the global costmap; false with `why` when there is no plan.
-  bool plan(core::GlobalPlanner& planner, const Vec3& start, const Vec3& goal, Path2& path, std::string& why) {
+  /// Plans on the global costmap; false with `why` when there is no plan. `used_lethal_cost`: the
+  /// lethal_cost the plan was made with.
+  bool plan(core::GlobalPlanner& planner, const Vec3& start, const Vec3& goal, Path2& path, std::string& why,
+            int* used_lethal_cost = nullptr) {
     double resolution;
     core::Plan p;
+    int lethal;
     {
       auto guard = global_->lock();
-      planner.setLethalCost(lethalCost());
+      lethal = lethalCost();
+      planner.setLethalCost(lethal);
       p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
+      if (p.status == core::PlanStatus::kNoPath && lethal < core::cost::kInscribed) {
+        // No way keeps the footprint clear at every cell centre: one through cells where it may
+        // touch (ROS's rule) is still worth trying, the robot is not held to cell centres.
+        planner.setLethalCost(core::cost::kInscribed);
+        core::Plan loose = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
+        if (loose.status == core::PlanStatus::kOk) {
+          ROS_INFO_THROTTLE(10.0, "move_base: no way with the footprint clear at every cell; planning through cells where "
+                                  "it may touch an obstacle (lethal_cost 253)");
+          p = std::move(loose);
+          lethal = core::cost::kInscribed;
+        }
+      }
       resolution = global_->master().resolution();
     }
+    if (used_lethal_cost) *used_lethal_cost = lethal;
     if (p.status != core::PlanStatus::kOk) {
       why = std::string(core::toString(p.status)) + ": " + p.message;
       return false;
@@ -385,13 +402,13 @@ class MoveBase {
       return current;
     }
     bool makePlan(const Vec3& start, const Vec3& goal, Path2& path, std::string& why) override {
-      return mb_.plan(*mb_.planner_, start, goal, path, why);
+      return mb_.plan(*mb_.planner_, start, goal, path, why, &mb_.plan_lethal_cost_);
     }
     bool planBlocked(const Path2& path, const Vec3& pose) override {
       auto guard = mb_.global_->lock();
       const auto& map = mb_.global_->master();
       return core::planBlocked(map, path, pose.head<2>(), mb_.global_->config().circumscribed_radius + map.resolution(),
-                               mb_.lethalCost());
+                               mb_.plan_lethal_cost_);
     }
     void planMade(const Path2& path, double goal_yaw) override {
       mb_.publishPath({&mb_.plan_pub_, &mb_.generic_plan_pub_}, path, mb_.global_->config().global_frame, goal_yaw);
@@ -675,6 +692,7 @@ class MoveBase {
   core::MoveBaseConfig config_;
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
   bool auto_lethal_cost_ = true;
+  int plan_lethal_cost_ = core::cost::kInscribed;  // the lethal_cost the followed plan was made with
   /// The global planner's lethal_cost (the global costmap's lock held).
   int lethalCost() const { return auto_lethal_cost_ ? global_->contactCost() : config_.planner.lethal_cost; }
   std::unique_ptr<core::TrajectoryController> controller_;
