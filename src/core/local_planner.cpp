@@ -23,6 +23,8 @@ constexpr double kFacingAway_rad = M_PI / 3.0;
 // enough that the cells' 45-degree steps average out, near enough to be the way out of where it
 // stands.
 constexpr double kTurnLookahead_m = 0.5;
+// [rad] Within this of the plan kTurnLookahead_m ahead the robot faces its way.
+constexpr double kFacingPlan_rad = 0.35;
 
 bool isObstacleValue(uint8_t v) { return v == cost::kLethal || v == cost::kInscribed || v == cost::kNoInformation; }
 
@@ -590,6 +592,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
   Trajectory best, comp;
   best.cost = -1.0;
   bool progressing = false;  // some valid forward trajectory ends nearer the plan and goal, or farther along the plan
+  bool any_forward = false;  // some forward trajectory is valid
   const double progress_now = progressAt(map, pose);
   const int along_now = alongPlan(pose.head<2>());
   if ((pose.head<2>() - spin_spot_).norm() > kSpinSpot_m) {
@@ -626,6 +629,7 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     auto consider = [&](double vx, double vy, double vth) {
       generate(map, pose, vel, vx, vy, vth, impossible, comp, -std::numeric_limits<double>::infinity());
       if (comp.cost < 0) return;
+      any_forward = any_forward || comp.xv > 0;
       // Farther along the plan and still on it (two cells) is progress too, whatever the
       // 4-connected distances say: they step by a cell either way along a diagonal.
       if (comp.xv > 0 && !progressing &&
@@ -697,6 +701,20 @@ Trajectory LocalPlanner::createTrajectories(const Costmap& map, const Eigen::Vec
     const Eigen::Vector3d& e = t.points.back();
     return std::abs(normalizeAngle(std::atan2(turn_to.y() - e.y(), turn_to.x() - e.x()) - e.z()));
   };
+  if (!escaping_ && aim && !any_forward &&
+      std::abs(normalizeAngle(std::atan2(turn_to.y() - pose.y(), turn_to.x() - pose.x()) - pose.z())) < kFacingPlan_rad) {
+    // Facing the plan and no forward move fits: the robot stands where the way ahead is too tight
+    // from its pose, though not from the plan's cells (the plan keeps the footprint clear at cell
+    // centres; the robot is beside them). Turning on the spot shows nothing new, and in clutter
+    // the robot turned on through a full circle; backing up, still facing the way, gives it the
+    // room to come onto the plan. Escape mode is not entered: it would forbid driving on.
+    generate(map, pose, vel, p.escape_vel, 0.0, 0.0, std::numeric_limits<double>::infinity(), comp);
+    if (comp.cost >= 0) {
+      resetFlagsIfMoved(pose);
+      comp.cost = std::max(comp.cost, 1.0);
+      return comp;
+    }
+  }
   double heading_dist = std::numeric_limits<double>::max();
   double vth_samp = min_vth;
   for (int i = 0; i < p.vtheta_samples && (!progressing || facing_away); ++i) {
