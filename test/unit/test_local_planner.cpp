@@ -420,3 +420,41 @@ TEST(LocalPlanner, MeterScoringScalesTheOccupancyWeightByTheResolutionAsRosDoes)
     EXPECT_NEAR(more - base, meter ? 0.01 * 0.05 * 100 : 0.01 * 100, 1e-9) << "meter_scoring " << meter;
   }
 }
+
+TEST(LocalPlanner, APlanThroughAWallOnlyTheLocalCostmapSeesStillGivesACommand) {
+  // The global plan runs through a wall the local costmap has just seen (the global costmap,
+  // updated less often, has not yet). ROS measures the goal distance to the last plan point in the
+  // local map, behind the wall: no cell the robot can reach has one, every trajectory is invalid,
+  // and the robot stood while move_base made the same plan again every cycle. Here the local goal
+  // is the last plan point the robot can reach, and it drives on until move_base replans.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int y = 0; y < 100; ++y) raw.setCost({70, y}, cost::kLethal);  // a wall at x = 3.5 m, all across
+  const Costmap m = inflated(raw);
+  LocalPlanner lp(tutorialParams(), circleFootprint(0.2));
+  lp.setPlan(straightPlan({1.0, 2.5}, {4.8, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {1.0, 2.5, 0.0}, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0) << "no command: the robot stands";
+  EXPECT_GT(t.xv, 0.0);
+  EXPECT_LE(lp.localGoal().x(), 3.5 - 0.2 + 1e-9) << "the local goal lies before the wall and its inscribed band";
+}
+
+TEST(LocalPlanner, FacingThePlanWithNoRoomAheadItBacksUpInsteadOfTurning) {
+  // The robot stands facing its plan with an obstacle just beyond its footprint: no forward move
+  // fits, every turn on the spot does (a round robot). ROS turns, and then may not turn back (its
+  // oscillation flags): in clutter a full circle. Here it backs up along the way it faces.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  for (int y = 45; y <= 55; ++y) raw.setCost({55, y}, cost::kLethal);  // cells x 2.75 .. 2.80, just ahead
+  const Costmap m = inflated(raw);
+  LocalPlanner lp(tutorialParams(), circleFootprint(0.2));
+  lp.setPlan(straightPlan({2.52, 2.5}, {4.5, 2.5}));
+  const Trajectory t = lp.findBestPath(m, {2.52, 2.5, 0.0}, {0, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_LT(t.xv, 0.0);
+  EXPECT_EQ(t.thetav, 0.0);
+  EXPECT_FALSE(lp.escaping()) << "escape mode would forbid driving on once there is room";
+  // Turned away from the plan, the same robot turns towards it as before.
+  const Trajectory turn = lp.findBestPath(m, {2.52, 2.5, 1.2}, {0, 0, 0});
+  ASSERT_GE(turn.cost, 0.0);
+  EXPECT_EQ(turn.xv, 0.0);
+  EXPECT_LT(turn.thetav, 0.0);
+}
