@@ -28,6 +28,13 @@
 // robot's heading, a valid rotation in place is taken even though a slow forward arc would make
 // progress (before, the robot crawled sideways to such a plan at min_vel_x: the slow arcs end in
 // the same cells, and the straight one wins the tie).
+// Turning on the spot aims at the plan 0.5 m ahead (ROS: at the neighbouring cell of least goal
+// distance, which around obstacles can point away from the plan). Facing the plan (within 20
+// degrees) with no valid forward move, the robot backs up at escape_vel without entering escape
+// mode instead of turning: the plan keeps the footprint clear at cell centres, and a robot beside
+// them needs room to come onto it. The local goal is the last plan point that the robot can reach
+// through the local costmap (ROS: the last one in the map, which may lie behind an obstacle only
+// the local costmap has seen yet, and then no trajectory is valid).
 //
 // Frames: every pose is in the local costmap's global frame (x [m], y [m], yaw [rad]); velocities
 // are in the robot frame (vx, vy [m/s], vtheta [rad/s]).
