@@ -213,9 +213,10 @@ class MoveBase {
       lethal = lethalCost();
       planner.setLethalCost(lethal);
       p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
-      if (p.status == core::PlanStatus::kNoPath && lethal < core::cost::kInscribed) {
+      if (p.status == core::PlanStatus::kNoPath && auto_lethal_cost_ && lethal < core::cost::kInscribed) {
         // No way keeps the footprint clear at every cell centre: one through cells where it may
-        // touch (ROS's rule) is still worth trying, the robot is not held to cell centres.
+        // touch (ROS's rule) is still worth trying, the robot is not held to cell centres. (A
+        // lethal_cost the user set is kept, as global_planner keeps it.)
         planner.setLethalCost(core::cost::kInscribed);
         core::Plan loose = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
         if (loose.status == core::PlanStatus::kOk) {
