@@ -257,7 +257,12 @@ ControlResult TrajectoryController::compute(const Costmap& costmap, const Eigen:
   rotating_to_goal_ = false;
   const Trajectory best = planner_.findBestPath(costmap, pose, vel);
   out.footprint_scale = planner_.lastFootprintScale();
-  out.obstacle_inside_m = planner_.lastObstacleInside();
+  // Said only for a lethal cell deeper than one cell inside the outline: nearer the outline it is
+  // the grid's rounding of a surface the robot has come up to (a cell holds a surface point
+  // anywhere in it), which happens beside obstacles in clutter; the rule on the distance applies
+  // either way.
+  const double inside = planner_.lastObstacleInside();
+  if (inside < inscribedRadius(planner_.footprint()) - costmap.resolution()) out.obstacle_inside_m = inside;
   last_trajectory_ = best.points;
   if (best.cost < 0) {
     out.why = "no valid trajectory (every sampled command collides or leaves the plan)";

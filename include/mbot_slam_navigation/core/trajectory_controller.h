@@ -41,7 +41,7 @@ struct ControlResult {
   Eigen::Vector3d command = Eigen::Vector3d::Zero();  ///< (vx, vy, vtheta)
   std::string why;                                    ///< why not, when !valid
   double footprint_scale = 1.0;                       ///< < 1: moving out of an obstacle the footprint touched
-  double obstacle_inside_m = std::numeric_limits<double>::infinity();  ///< [m] LocalPlanner::lastObstacleInside
+  double obstacle_inside_m = std::numeric_limits<double>::infinity();  ///< [m] LocalPlanner::lastObstacleInside, when more than a cell inside the outline
 };
 
 class TrajectoryController {
