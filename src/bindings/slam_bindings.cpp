@@ -192,6 +192,7 @@ void bindSlam(py::module& m) {
              d["local_match_failures"] = st.local_match_failures;
              d["innovation_rms"] = st.innovation_rms;
              d["pinned_innovation_rms"] = st.pinned_innovation_rms;
+             d["odometry_trust"] = st.odometry_trust;
              d["match_weakest_m"] = st.match_weakest_m;
              d["prior_weight"] = st.prior_weight;
              d["search_window_m"] = st.search_window_m;

@@ -479,5 +479,36 @@ Eigen::Matrix3d scoreCurvature(const LikelihoodGrid& grid, const std::vector<Eig
   return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
 }
 
+MatchDirections matchDirections(const Eigen::Matrix3d& curvature, const std::vector<Eigen::Vector2d>& points) {
+  MatchDirections d;
+  if (!points.empty()) {
+    double range = 0.0;
+    for (const auto& p : points) range += p.norm();
+    d.range_m = std::max(range / static_cast<double>(points.size()), 1e-3);
+  }
+  const Eigen::DiagonalMatrix<double, 3> unscale(1.0, 1.0, 1.0 / d.range_m);
+  const Eigen::Matrix3d scaled = unscale * curvature * unscale;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scaled);
+  d.vectors = eig.eigenvectors();
+  d.values = eig.eigenvalues().cwiseMax(0.0);
+  return d;
+}
+
+Eigen::Vector3d MatchDirections::scaled(const Eigen::Vector3d& delta) const {
+  return {delta.x(), delta.y(), range_m * delta.z()};
+}
+
+Eigen::Vector3d MatchDirections::weighOpen(const Eigen::Vector3d& delta, double min_curvature,
+                                           double prior_curvature) const {
+  const Eigen::Vector3d s = scaled(delta);
+  Eigen::Vector3d kept = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const double share =
+        values[k] >= min_curvature ? 1.0 : values[k] / std::max(values[k] + std::max(prior_curvature, 0.0), 1e-12);
+    kept += share * vectors.col(k) * vectors.col(k).dot(s);
+  }
+  return {kept.x(), kept.y(), kept.z() / range_m};
+}
+
 }  // namespace core
 }  // namespace mbot

@@ -397,35 +397,46 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
   }
   // How far the scan moves odometry's prediction, over the last few hundred scans: small where
   // odometry is good (the simulator: 3 mm a scan), large where it slips (the Radish logs: 28-33 mm).
-  // Only in the directions the scan pins (its score curves down there as if at least
-  // kConstrainedShare of the returns lay on surfaces square to it): along a plain corridor the
-  // best match lies anywhere in the window, and that says nothing of odometry.
+  // Only in the directions the scan pins, in x, y and yaw together (matchDirections): its score
+  // curves down there as if at least kConstrainedShare of the returns, and at least
+  // kMinPinnedReturns of them, lay on surfaces square to it. Along a plain corridor the best match
+  // lies anywhere in the window, around a lone pillar anywhere on a turn about it, and a few
+  // returns of a wall at the laser's reach pin nothing for sure: none of that says anything of
+  // odometry.
   const Eigen::Matrix3d curvature = scoreCurvature(grid, points, refined);
   const double sigma = localSigma();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> xy(curvature.topLeftCorner<2, 2>());
-  const Eigen::Vector2d e = refined.head<2>() - predicted.head<2>();
+  const double returns = static_cast<double>(points.size());
+  const double pinned_curvature = std::max(kConstrainedShare, kMinPinnedReturns / returns) / (sigma * sigma);
+  const double open_curvature = kMinPinnedReturns / returns / (sigma * sigma);
+  const MatchDirections directions = matchDirections(curvature, points);
+  const Eigen::Vector3d moved(refined.x() - predicted.x(), refined.y() - predicted.y(),
+                              normalizeAngle(refined.z() - predicted.z()));
+  const Eigen::Vector3d scaled_moved = directions.scaled(moved);
   double pinned2 = 0.0;
   int pinned = 0;
-  for (int k = 0; k < 2; ++k) {
-    if (xy.eigenvalues()[k] * sigma * sigma < kConstrainedShare) continue;
-    const double along = xy.eigenvectors().col(k).dot(e);
+  for (int k = 0; k < 3; ++k) {
+    if (directions.values[k] < pinned_curvature) continue;
+    const double along = directions.vectors.col(k).dot(scaled_moved);
     pinned2 += along * along;
     ++pinned;
   }
   double prior_weight = params_.local_prior_weight;
+  double odometry_trust = 0.0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    stats_.match_weakest_m = 1.0 / std::sqrt(std::max(xy.eigenvalues().minCoeff() * params_.local_prior_points, 1e-12));
+    stats_.match_weakest_m = 1.0 / std::sqrt(std::max(directions.values.minCoeff() * params_.local_prior_points, 1e-12));
     // The plain mean until kInnovationWindow scans, then a running one over about that many (a
     // running mean from the first scan on would still be mostly that scan's at the warm-up's end).
     // The window must hold odometry's worst steps, wherever the scan looked: every direction.
-    const double all2 = e.squaredNorm();
+    const double all2 = moved.head<2>().squaredNorm();
     innovation2_ += (all2 - innovation2_) / std::min<double>(innovations_ + 1, kInnovationWindow);
     ++innovations_;
     // The prior's weight, from the pinned directions only (per direction, counted as the 2-d
-    // squared distance: twice it).
+    // squared distance: twice it), each match's share clipped (one wrong match must not make good
+    // odometry look bad: the weight fell from 490 to its floor at one, and the scans after it drifted).
     if (pinned > 0) {
-      const double pinned_mean2 = 2.0 * pinned2 / pinned;
+      double pinned_mean2 = 2.0 * pinned2 / pinned;
+      if (pinned_innovations_ >= kInnovationWarmup) pinned_mean2 = std::min(pinned_mean2, kInnovationClip * pinned_innovation2_);
       pinned_innovation2_ +=
           (pinned_mean2 - pinned_innovation2_) / std::min<double>(pinned_innovations_ + 1, kInnovationWindow);
       ++pinned_innovations_;
@@ -434,8 +445,13 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
       // Never below the configured weight.
       prior_weight = std::clamp(1.0 / (2.0 * params_.local_prior_points * std::max(pinned_innovation2_, 1e-8)),
                                 params_.local_prior_weight, std::max(params_.local_prior_weight, kMaxPriorWeight));
+      // Odometry that has shown itself good to a fraction of a cell a scan (kTrustedOdometryCells):
+      // fully trusted up to that, not at all from twice that.
+      const double trusted_m = kTrustedOdometryCells * params_.delta;
+      odometry_trust = std::clamp(2.0 - std::sqrt(pinned_innovation2_) / trusted_m, 0.0, 1.0);
     }
     stats_.prior_weight = prior_weight;
+    stats_.odometry_trust = odometry_trust;
     stats_.innovation_rms = std::sqrt(innovation2_);
     stats_.pinned_innovation_rms = std::sqrt(pinned_innovation2_);
     if (params_.local_search_sigmas > 0.0 && innovations_ >= kInnovationWarmup) {
@@ -444,6 +460,7 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     }
     stats_.search_window_m = search_window_;
   }
+  Eigen::Vector3d chosen = refined;
   if (params_.local_prior_margin > 0.0) {
     // The local optimum nearest the prediction, if nearly as good: odometry decides what the scan
     // leaves open, the scan what it fixes (the climb follows every slope the scan has).
@@ -452,10 +469,19 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
     if (near_score >= (1.0 - params_.local_prior_margin) * score &&
         (near.head<2>() - predicted.head<2>()).cwiseAbs().maxCoeff() <= window &&
         std::abs(normalizeAngle(near.z() - predicted.z())) <= params_.local_search_angle) {
-      return near;
+      chosen = near;
     }
   }
-  return refined;
+  // Along the directions the scan leaves open (fewer than kMinPinnedReturns returns' worth: a turn
+  // around a lone pillar, along one plain wall, a wall at the laser's reach), the match's answer
+  // is mostly noise: there it is weighed against odometry's prediction, whose curvature is the
+  // prior's (2 prior_weight), as far as odometry is trusted. Zhang, Kaess and Singh take such
+  // degenerate directions from the prior. The heading too: a turn the scan cannot see would
+  // otherwise enter the map (an open hall's map came back rotated by 8-17 degrees in pieces).
+  const Eigen::Vector3d kept = directions.weighOpen(
+      Eigen::Vector3d(chosen.x() - predicted.x(), chosen.y() - predicted.y(), normalizeAngle(chosen.z() - predicted.z())),
+      open_curvature, odometry_trust * 2.0 * prior_weight);
+  return {predicted.x() + kept.x(), predicted.y() + kept.y(), normalizeAngle(predicted.z() + kept.z())};
 }
 
 void GraphSlam::backgroundLoop() {

@@ -336,13 +336,14 @@ class SlamGmappingNode {
     ROS_INFO("slam_gmapping: %d nodes (%d revisits, %d of them with their scan freed, %d out of the optimization), "
              "%d submaps (%.1f MB), %d loop closures (%d of them measured again with what their submap saw, %d to the submap just behind the local map, %d in the graph), %d optimizations (last %.0f ms); "
              "closure search backlog %d nodes (at most %d); "
-             "scans move odometry's prediction by %.1f mm (rms; %.1f mm where they pin it), so its prior weighs %.0f "
-             "and the search window is +-%.2f m; "
+             "scans move odometry's prediction by %.1f mm (rms; %.1f mm where they pin it), so its prior weighs %.0f, "
+             "it decides %.0f%% of what scans leave open, and the search window is +-%.2f m; "
              "heap %.1f MB in use, %.1f MB free",
              s.nodes, s.redundant_nodes, s.trimmed_nodes, s.merged_nodes, s.submaps, s.submap_bytes / 1e6,
              s.closures_accepted, s.closures_remeasured, s.closures_recent, s.loop_closures, s.optimizations, s.last_optimization_ms, s.closure_backlog,
              s.closure_backlog_max,
-             1000.0 * s.innovation_rms, 1000.0 * s.pinned_innovation_rms, s.prior_weight, s.search_window_m,
+             1000.0 * s.innovation_rms, 1000.0 * s.pinned_innovation_rms, s.prior_weight, 100.0 * s.odometry_trust,
+             s.search_window_m,
              (heap.uordblks + heap.hblkhd) / 1e6, heap.fordblks / 1e6);
   }
 

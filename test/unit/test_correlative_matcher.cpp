@@ -364,3 +364,42 @@ TEST(CorrelativeMatcher, TheScoresCurvatureSaysWhichDirectionsAScanFixes) {
   EXPECT_GT(c(2, 2), 0.0) << c;                   // and the heading
   EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c).eigenvalues().minCoeff(), -1e-9);
 }
+
+TEST(CorrelativeMatcher, MatchDirectionsFindATurnAroundALonePillar) {
+  // A lone pillar 2 m ahead: the score pins the distance and the bearing to it, and x-y alone looks
+  // pinned both ways, but a step sideways with a turn the other way (a turn around the pillar)
+  // leaves the returns where they were: matchDirections must find that direction open.
+  World2D w;
+  w.addCylinder({2.0, 0.0}, 0.3);
+  std::mt19937 rng(5);
+  const double sigma = 0.075;
+  const Eigen::Vector3d pose(0.0, 0.0, 0.0);
+  const auto points = matchPoints(scanAt(w, pose, rng, 0.0), Eigen::Vector3d::Zero(), 6.0, 0.05);
+  ASSERT_GT(points.size(), 5u);
+  const LikelihoodGrid grid(
+      inWorld(surfacePoints(scanAt(w, pose, rng, 0.0), Eigen::Vector3d::Zero(), 6.0, 0.05), pose), 0.05, sigma);
+  const Eigen::Matrix3d c = scoreCurvature(grid, points, pose);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> xy(c.topLeftCorner<2, 2>());
+  EXPECT_GT(xy.eigenvalues().minCoeff() * sigma * sigma, 0.1) << "x-y alone looks pinned\n" << c;
+  const MatchDirections d = matchDirections(c, points);
+  EXPECT_NEAR(d.range_m, 1.7, 0.1);
+  // Nearly flat against the other two (the pillar's round face and the turn's centre, the robot,
+  // 2 m from it, leave a little).
+  EXPECT_LT(d.values[0] * sigma * sigma, 0.1) << d.values.transpose();
+  EXPECT_LT(d.values[0], 0.1 * d.values[1]) << d.values.transpose();
+  EXPECT_GT(d.values[1] * sigma * sigma, 0.1) << d.values.transpose();
+  // The open direction: a step sideways (y) with a turn, in the scaled space.
+  const Eigen::Vector3d open = d.vectors.col(0);
+  EXPECT_LT(std::abs(open.x()), 0.2) << open.transpose();
+  EXPECT_GT(std::abs(open.y()), 0.5) << open.transpose();
+  EXPECT_GT(std::abs(open.z()), 0.4) << open.transpose();
+  // weighOpen: a step along the open direction is given to the prediction as far as its curvature
+  // says; a step along a pinned one is kept.
+  const Eigen::Vector3d step_open(open.x(), open.y(), open.z() / d.range_m);
+  const Eigen::Vector3d pinned = d.vectors.col(2);
+  const Eigen::Vector3d step_pinned(pinned.x(), pinned.y(), pinned.z() / d.range_m);
+  const double open_curvature = 0.05 / (sigma * sigma);
+  EXPECT_LT(d.weighOpen(0.1 * step_open, open_curvature, 1000.0).norm(), 0.01);
+  EXPECT_NEAR((d.weighOpen(0.1 * step_open, open_curvature, 0.0) - 0.1 * step_open).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((d.weighOpen(0.1 * step_pinned, open_curvature, 1000.0) - 0.1 * step_pinned).norm(), 0.0, 1e-9);
+}

@@ -186,6 +186,25 @@ MatchResult matchBranchAndBound(const LikelihoodGrid& grid, const std::vector<Ei
 Eigen::Matrix3d scoreCurvature(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
                                const Eigen::Vector3d& pose);
 
+/// The directions a match fixes and those it leaves open: the eigenvectors of scoreCurvature with
+/// the yaw scaled to metres at the returns' mean range (a turn by a moves them by about range * a),
+/// so that x, y and yaw compare. Coupled directions show as such: a lone pillar fixes the distance
+/// and the bearing to it, but not a turn around it (a step sideways and a turn together), which the
+/// x-y block alone would call pinned.
+struct MatchDirections {
+  Eigen::Matrix3d vectors = Eigen::Matrix3d::Identity();  ///< columns: unit (x [m], y [m], range * yaw [m])
+  Eigen::Vector3d values = Eigen::Vector3d::Zero();       ///< curvature along each [score/m^2], ascending
+  double range_m = 1.0;                                   ///< [m] the returns' mean range, the yaw's scale
+  /// (x [m], y [m], yaw [rad]) as (x, y, range * yaw) [m].
+  Eigen::Vector3d scaled(const Eigen::Vector3d& delta) const;
+  /// `delta` (x, y, yaw), the match's step from a prediction, with its components along the
+  /// directions curving less than `min_curvature` weighed against the prediction's own curvature
+  /// `prior_curvature` [score/m^2] (kept in the share values / (values + prior_curvature), the
+  /// Gaussian fusion of the two): where the scan says little, the prediction decides.
+  Eigen::Vector3d weighOpen(const Eigen::Vector3d& delta, double min_curvature, double prior_curvature) const;
+};
+MatchDirections matchDirections(const Eigen::Matrix3d& curvature, const std::vector<Eigen::Vector2d>& points);
+
 /// Hill-climbs the interpolated score from `init` with steps from half a cell and `angular_step`,
 /// halved `halvings` times; returns the pose and writes its score. With `prior_weight` > 0 it climbs
 /// score - prior_weight * |xy - init xy|^2 [1/m^2] instead (a pull back to `init` where the score is

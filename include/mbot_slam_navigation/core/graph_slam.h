@@ -217,6 +217,8 @@ struct GraphSlamStats {
   double pinned_innovation_rms = 0.0;
   double search_window_m = 0.0;     ///< [m] the tracking window at the last scan (local_search_sigmas)
   double prior_weight = 0.0;        ///< [1/m^2] the climb's weight at the last scan
+  /// [0, 1] how far odometry decided the directions the last match left open (kTrustedOdometryCells)
+  double odometry_trust = 0.0;
   /// [m] How weakly the last tracked scan fixed its position: the standard deviation along the
   /// direction its match constrains least (scoreCurvature, the score counted as local_prior_points
   /// returns, a cautious count). About 1 cm in a room, 5-6 cm or more along a plain corridor.
@@ -431,6 +433,17 @@ class GraphSlam : public SlamBackend {
   // A direction counts as pinned by a match (for odometry's record) when the score curves down
   // along it by this share of what a scan whose every return pinned it would give (1 / sigma^2).
   static constexpr double kConstrainedShare = 0.1;
+  // And by at least this many returns' worth (the mean score's curvature times n sigma^2, n the
+  // returns): a few returns of a wall at the laser's reach pin nothing for sure. A direction below
+  // this is open: weighed against odometry's prediction (matchLocally).
+  static constexpr double kMinPinnedReturns = 10.0;
+  // One match's squared innovation enters odometry's record clipped at this many times the record's
+  // mean (3 sigma): a single wrong match must not make good odometry look bad.
+  static constexpr double kInnovationClip = 9.0;
+  // Odometry decides the open directions once its record (the pinned innovations' rms) is within
+  // this many map cells a scan, and not at all from twice that: the simulator's 3-5 mm are within,
+  // the Radish logs' 18-50 mm (wheels that slip, where the scan knows better) are not.
+  static constexpr double kTrustedOdometryCells = 0.2;
   double innovation2_ = 0.0;
   long innovations_ = 0;
   // The same over the directions each match pinned (the prior's weight), per direction times 2.
