@@ -212,6 +212,7 @@ void bindSlam(py::module& m) {
              d["merged_nodes"] = st.merged_nodes;
              d["closures_moved"] = st.closures_moved;
              d["closures_remeasured"] = st.closures_remeasured;
+             d["closures_partial"] = st.closures_partial;
              d["closures_recent"] = st.closures_recent;
              d["closures_unsolved"] = st.closures_unsolved;
              d["closure_backlog"] = st.closure_backlog;

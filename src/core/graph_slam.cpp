@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -614,6 +615,9 @@ bool GraphSlam::searchClosures(int n) {
     int ambiguous = 0;
     Eigen::Vector3d refined;
     double score = 0.0;
+    // A closure ambiguous only along one direction, kept in the others: the projection onto them
+    // (x, y, yaw of the node in the submap's frame).
+    std::optional<Eigen::Matrix3d> partial;
     if (found.found) {
       refined = refineMatch(*c.grid, *points, found.pose, 0.005, 4, &score);
       // The geometric check: a second pose elsewhere that explains the scan almost as well means
@@ -621,7 +625,9 @@ bool GraphSlam::searchClosures(int n) {
       const MatchResult other = matchBranchAndBound(*c.grid, *points, init, window, params_.loop_ambiguity * found.score,
                                                     &found.pose, 0.3, 0.1);
       ambiguous = other.found ? 1 : 0;
-      if (!ambiguous && c.seen) {
+      if (ambiguous && !c.recent) partial = partialClosure(*c.grid, *points, refined, other.pose);
+      if (partial) ambiguous = 0;
+      if (!ambiguous && !partial && c.seen) {
         // Scored with every return, a pose nearer the submap's nodes covers more of the scan with
         // what they saw (as in tracking, Visibility): along an office corridor a node was put
         // 2.8 m back, onto the doors before it, and the chain bent to follow. So the best pose
@@ -646,7 +652,7 @@ bool GraphSlam::searchClosures(int n) {
       }
     }
     bool remeasured = false;
-    if (found.found && !ambiguous && c.seen && params_.loop_visible_shift > 0.0) {
+    if (found.found && !ambiguous && !partial && c.seen && params_.loop_visible_shift > 0.0) {
       // Measured with every return, a closure leans towards the submap: a scan from the other side
       // of a wall sees its other face, a wall's thickness (0.1 m in the generated worlds) behind the
       // face the submap drew, and those returns pull the scan towards it (a large-floor run's
@@ -692,13 +698,25 @@ bool GraphSlam::searchClosures(int n) {
       const double q = nearest / params_.loop_sigma_distance;
       scale = std::sqrt(1.0 + q * q);
     }
-    edges_.push_back({c.anchor_index, n, refined, edgeInformation(scale), true});
+    Eigen::Matrix3d information = edgeInformation(scale);
+    if (partial) {
+      // Nothing along the open direction: the information of the pinned ones, in the submap's
+      // frame (P^T I P), then in the edge error's, the node's frame (edgeError).
+      const Eigen::Matrix3d in_submap = partial->transpose() * information * *partial;
+      Eigen::Matrix3d to_error = Eigen::Matrix3d::Identity();
+      to_error.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(refined.z()).toRotationMatrix().transpose();
+      information = to_error * in_submap * to_error.transpose();
+    }
+    edges_.push_back({c.anchor_index, n, refined, information, true});
     ++stats_.closures_accepted;
     if (remeasured) ++stats_.closures_remeasured;
+    if (partial) ++stats_.closures_partial;
     if (c.recent) {
       ++stats_.closures_recent;
-    } else {
-      last_closure_travelled_ = travelled;  // the drift since a recent submap says nothing of a loop's
+    } else if (!partial) {
+      // The drift since a recent submap says nothing of a loop's, and a partial closure leaves
+      // the drift along its open direction.
+      last_closure_travelled_ = travelled;
     }
     const Eigen::Vector3d err = edgeError(nodes_[c.anchor_index].pose, nodes_[n].pose, refined);
     if (err.dot(edges_.back().information * err) > params_.loop_solve_chi2) {
@@ -708,6 +726,30 @@ bool GraphSlam::searchClosures(int n) {
     }
   }
   return added;
+}
+
+std::optional<Eigen::Matrix3d> GraphSlam::partialClosure(const LikelihoodGrid& grid,
+                                                         const std::vector<Eigen::Vector2d>& points,
+                                                         const Eigen::Vector3d& found,
+                                                         const Eigen::Vector3d& other) const {
+  if (points.empty()) return std::nullopt;
+  const MatchDirections d = matchDirections(scoreCurvature(grid, points, found), points);
+  const double sigma = params_.match_sigma;
+  const double returns = static_cast<double>(points.size());
+  const double open_curvature = kMinPinnedReturns / returns / (sigma * sigma);
+  const double pinned_curvature = std::max(kConstrainedShare, kMinPinnedReturns / returns) / (sigma * sigma);
+  // Exactly one direction open, the two others pinned.
+  if (!(d.values[0] < open_curvature && d.values[1] >= pinned_curvature)) return std::nullopt;
+  // The other match differs from this one along the open direction only (a wall matched elsewhere
+  // along it), not across it (a parallel wall, a corridor's other side).
+  const Eigen::Vector3d diff = d.scaled(
+      Eigen::Vector3d(other.x() - found.x(), other.y() - found.y(), normalizeAngle(other.z() - found.z())));
+  const Eigen::Vector3d open = d.vectors.col(0);
+  if ((diff - open * open.dot(diff)).norm() > kPartialAcross) return std::nullopt;
+  // The projection onto the pinned directions, in unscaled (x, y, yaw): S V V^T S^-1.
+  const Eigen::DiagonalMatrix<double, 3> to_unscaled(1.0, 1.0, 1.0 / d.range_m), to_scaled(1.0, 1.0, d.range_m);
+  const Eigen::Matrix3d kept = d.vectors.rightCols<2>() * d.vectors.rightCols<2>().transpose();
+  return Eigen::Matrix3d(to_unscaled * kept * to_scaled);
 }
 
 void GraphSlam::cachePyramid(const std::shared_ptr<const LikelihoodGrid>& grid) {

@@ -228,6 +228,9 @@ struct GraphSlamStats {
   int closures_accepted = 0;        ///< closures ever accepted (some since merged into others)
   int closures_moved = 0;           ///< closures moved from a merged node to the node before it
   int closures_remeasured = 0;      ///< closures accepted as measured again with what their submap saw (loop_visible_shift)
+  /// closures accepted in part: ambiguous only along one direction (a plain wall seen again), their
+  /// information kept in the directions the match pins
+  int closures_partial = 0;
   int closures_recent = 0;          ///< closures accepted to the submap just behind the local map (loop_recent_submap)
   int merged_nodes = 0;             ///< trimmed nodes taken out of the optimization
   int loop_rejected_ambiguous = 0;
@@ -367,6 +370,12 @@ class GraphSlam : public SlamBackend {
   /// Closure search for one node and the submap that it completes; returns true if it added an
   /// edge that the current estimate does not already satisfy (loop_solve_chi2).
   bool searchClosures(int node);
+  /// A closure whose second-best match `other` lies along the one direction its best `found` leaves
+  /// open (a plain wall seen again, matched anywhere along it): the projection onto the two
+  /// directions it pins (x, y, yaw of the node in the submap's frame), so that it constrains the
+  /// distance to the wall and the heading and leaves the rest to the chain. nullopt otherwise.
+  std::optional<Eigen::Matrix3d> partialClosure(const LikelihoodGrid& grid, const std::vector<Eigen::Vector2d>& points,
+                                                const Eigen::Vector3d& found, const Eigen::Vector3d& other) const;
   void buildSubmap(int first, int last);
   /// Whether a node at `pose` would repeat an older node that keeps its scan: within
   /// redundant_distance, and within redundant_angle of its heading unless the laser sees
@@ -444,6 +453,9 @@ class GraphSlam : public SlamBackend {
   // this many map cells a scan, and not at all from twice that: the simulator's 3-5 mm are within,
   // the Radish logs' 18-50 mm (wheels that slip, where the scan knows better) are not.
   static constexpr double kTrustedOdometryCells = 0.2;
+  // [m] A closure's second-best match may differ from the best across its open direction by this
+  // much (in x, y and the scaled yaw) and still count as the same wall matched elsewhere along it.
+  static constexpr double kPartialAcross = 0.1;
   double innovation2_ = 0.0;
   long innovations_ = 0;
   // The same over the directions each match pinned (the prior's weight), per direction times 2.
