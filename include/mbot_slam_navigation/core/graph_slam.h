@@ -126,11 +126,13 @@ struct GraphSlamParams {
   /// (`~local_prior_points`): the climb's weight is 1 / (2 N r^2), r the root mean square of how
   /// far the best match moved the prediction over the last 200 scans, N this value (the score
   /// counted as N independent returns), kept within [local_prior_weight, 5000]. r is measured only
-  /// along the directions each match pinned (its score curves down there as if a tenth of the
-  /// returns lay on surfaces square to it; scoreCurvature): along a plain corridor or one wall the
-  /// best match lies anywhere in the window, and counting it would make good odometry look bad.
-  /// Where odometry is good the prior holds what the scan says little of; where it slips the
-  /// weight stays near local_prior_weight. 0 keeps local_prior_weight throughout.
+  /// along the directions each match pinned, in x, y and yaw together (its score curves down there
+  /// as if a tenth of the returns, and at least 10, lay on surfaces square to it; matchDirections):
+  /// along a plain corridor or one wall the best match lies anywhere in the window, and counting it
+  /// would make good odometry look bad. Where odometry is good the prior holds what the scan says
+  /// little of, and the directions a match leaves open are weighed against its prediction
+  /// (matchLocally); where it slips the weight stays near local_prior_weight and the scan decides.
+  /// 0 keeps local_prior_weight throughout.
   double local_prior_points = 130.0;
   /// Track a scan only with the returns that the local map's scans could have seen (Visibility in
   /// correlative_matcher.h; `~local_visible_only`): the others, what came into view as the robot
@@ -220,8 +222,9 @@ struct GraphSlamStats {
   /// [0, 1] how far odometry decided the directions the last match left open (kTrustedOdometryCells)
   double odometry_trust = 0.0;
   /// [m] How weakly the last tracked scan fixed its position: the standard deviation along the
-  /// direction its match constrains least (scoreCurvature, the score counted as local_prior_points
-  /// returns, a cautious count). About 1 cm in a room, 5-6 cm or more along a plain corridor.
+  /// direction its match constrains least (matchDirections: x, y and the yaw in metres at the
+  /// returns' mean range; the score counted as local_prior_points returns, a cautious count). About
+  /// 1 cm in a room, 5-6 cm or more along a plain corridor, more beside a lone pillar.
   double match_weakest_m = 0.0;
   int loop_attempts = 0;            ///< submap matches tried
   int loop_closures = 0;            ///< closure edges in the graph
