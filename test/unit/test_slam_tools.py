@@ -118,6 +118,30 @@ def test_slam_offline_on_a_rosbag(tmp_path, backend, params):
     assert os.path.exists(out + '.pgm') and os.path.exists(out + '.yaml')
 
 
+def test_slam_offline_takes_a_bags_range_from_its_scans(tmp_path):
+    """Without maxUrange and maxRange, slam_offline takes the scans' range_max as the node does,
+    not 80 m: beams without a return then clear no more than the sensor reaches."""
+    import json
+
+    from mbot_slam_navigation.slam.offline import main
+
+    bag_path, _ = _room_drive_bag(tmp_path)
+    out = str(tmp_path / 'drive')
+    assert main([bag_path, '-o', out, '--quiet', '--param', 'linearUpdate=0.2', '--param', 'angularUpdate=0.2']) == 0
+    with open(out + '.timing.json') as f:
+        params = json.load(f)['params']
+    from mbot_slam_navigation.slam.offline import read_rosbag
+    sensor = read_rosbag(bag_path)[0].range_max
+    assert sensor is not None and sensor < 80.0
+    assert params['maxRange'] == pytest.approx(sensor) and params['maxUrange'] == pytest.approx(sensor)
+    # given, they are kept
+    assert main([bag_path, '-o', out, '--quiet', '--param', 'maxRange=10', '--param', 'linearUpdate=0.2',
+                 '--param', 'angularUpdate=0.2']) == 0
+    with open(out + '.timing.json') as f:
+        params = json.load(f)['params']
+    assert params['maxRange'] == 10.0 and params['maxUrange'] == pytest.approx(sensor)
+
+
 def test_a_log_mapped_in_two_sessions_ends_where_one_run_does(tmp_path, capsys):
     """slam_offline --session-out on the first half, --session-in on the second: the second half
     joins the saved map (given the pose where the first ended, or found by matching) and its

@@ -8,7 +8,7 @@ maxRange (80 m by default) skips them as gmapping does, rather than clearing the
 import bz2
 import math
 from dataclasses import dataclass
-from typing import List, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 
@@ -27,6 +27,7 @@ class Scan:
     angle_min: float                        # [rad]
     angle_increment: float                  # [rad]
     ranges: np.ndarray                      # float32 [m]
+    range_max: Optional[float] = None       # [m] the sensor's, where the log says it (a bag's LaserScan)
 
 
 def _text_lines(path: str):

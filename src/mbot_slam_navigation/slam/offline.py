@@ -17,7 +17,7 @@ import numpy as np
 
 from mbot_slam_navigation.maps.map_io import save_map
 from mbot_slam_navigation.slam.carmen import read_log
-from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, GraphSlam, make_slam
+from mbot_slam_navigation.slam.backends import BACKENDS, DEFAULT_BACKEND, OFFLINE_MAX_RANGE, GraphSlam, make_slam
 from mbot_slam_navigation.slam.relations import evaluate, read_relations
 from mbot_slam_navigation.transforms import compose2d, normalize_angle, quaternion_to_yaw, relative2d
 
@@ -95,7 +95,8 @@ def read_rosbag(path, scan_topic='/scan', odom_topic='/odom'):
         msg = raw[i]
         scans.append(Scan(time=stamps[i], odom=(x[i], y[i], normalize_angle(yaw[i])), laser_pose=(0.0, 0.0, 0.0),
                           angle_min=msg.angle_min, angle_increment=msg.angle_increment,
-                          ranges=np.asarray(msg.ranges, np.float32)))
+                          ranges=np.asarray(msg.ranges, np.float32),
+                          range_max=float(msg.range_max) if msg.range_max > 0.0 else None))
     return scans
 
 
@@ -140,7 +141,8 @@ def run(scans, params, progress=True, backend=DEFAULT_BACKEND, rate=0.0, backgro
             if wait > 0:
                 time.sleep(wait)
         c0 = time.process_time()
-        slam.process_scan(s.odom, s.angle_min, s.angle_increment, 0.0, params.get('maxRange', 80.0), s.ranges, s.time)
+        slam.process_scan(s.odom, s.angle_min, s.angle_increment, 0.0, params.get('maxRange', OFFLINE_MAX_RANGE), s.ranges,
+                        s.time)
         cpu += time.process_time() - c0
         if online is not None:
             online.append(slam.current_pose())
@@ -211,6 +213,12 @@ def main(argv=None):
     except ValueError as e:  # CarmenError, BagError: the file and what is wrong with it
         ap.exit(2, 'slam_offline: %s\n' % e)
     params = dict(args.param)
+    # maxUrange and maxRange not given: the scan's range_max, as the node takes them (a log without
+    # one: OFFLINE_MAX_RANGE). Longer, the beams without a return would clear the map out to it.
+    range_max = next((s.range_max for s in scans if s.range_max), None)
+    if range_max is not None:
+        for key in ('maxUrange', 'maxRange'):
+            params.setdefault(key, range_max)
     if (args.session_in or args.session_out) and args.backend != 'graph':
         ap.error('sessions are the graph backend\'s (--backend graph)')
     if (args.start_pose or args.start_at_dock or args.localize) and not args.session_in:
