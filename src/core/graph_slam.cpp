@@ -407,8 +407,8 @@ Eigen::Vector3d GraphSlam::matchLocally(const Eigen::Vector3d& predicted, const 
   const Eigen::Matrix3d curvature = scoreCurvature(grid, points, refined);
   const double sigma = localSigma();
   const double returns = static_cast<double>(points.size());
-  const double pinned_curvature = std::max(kConstrainedShare, kMinPinnedReturns / returns) / (sigma * sigma);
-  const double open_curvature = kMinPinnedReturns / returns / (sigma * sigma);
+  const double pinned_curvature = pinnedCurvature(returns, sigma);
+  const double open_curvature = openCurvature(returns, sigma);
   const MatchDirections directions = matchDirections(curvature, points);
   const Eigen::Vector3d moved(refined.x() - predicted.x(), refined.y() - predicted.y(),
                               normalizeAngle(refined.z() - predicted.z()));
@@ -734,12 +734,12 @@ std::optional<Eigen::Matrix3d> GraphSlam::partialClosure(const LikelihoodGrid& g
                                                          const Eigen::Vector3d& other) const {
   if (points.empty()) return std::nullopt;
   const MatchDirections d = matchDirections(scoreCurvature(grid, points, found), points);
-  const double sigma = params_.match_sigma;
   const double returns = static_cast<double>(points.size());
-  const double open_curvature = kMinPinnedReturns / returns / (sigma * sigma);
-  const double pinned_curvature = std::max(kConstrainedShare, kMinPinnedReturns / returns) / (sigma * sigma);
   // Exactly one direction open, the two others pinned.
-  if (!(d.values[0] < open_curvature && d.values[1] >= pinned_curvature)) return std::nullopt;
+  if (!(d.values[0] < openCurvature(returns, params_.match_sigma) &&
+        d.values[1] >= pinnedCurvature(returns, params_.match_sigma))) {
+    return std::nullopt;
+  }
   // The other match differs from this one along the open direction only (a wall matched elsewhere
   // along it), not across it (a parallel wall, a corridor's other side).
   const Eigen::Vector3d diff = d.scaled(

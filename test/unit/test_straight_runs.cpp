@@ -49,9 +49,9 @@ GraphSlamParams exploreParams() {
   return p;
 }
 
-/// Drives `run_m` metres along +x from `start` (world frame) at kSpeed, scanning at 10 Hz.
-RunResult driveStraight(const World2D& world, const Eigen::Vector3d& start, double slip, unsigned seed,
-                        double run_m = kRun) {
+/// The mbot as the simulator drives it, at `start` (world frame); odometry with the simulator's
+/// wheel slip `slip`, or exact when it is 0.
+DiffDrive mbotDrive(const Eigen::Vector3d& start, double slip, unsigned seed) {
   DiffDriveParams drive_params;
   drive_params.wheel_separation_m = 0.38;
   drive_params.wheel_diameter_m = 0.12;
@@ -59,7 +59,13 @@ RunResult driveStraight(const World2D& world, const Eigen::Vector3d& start, doub
   drive_params.slip_stddev = slip;
   drive_params.odometry_from_world = slip <= 0.0;
   const Polygon footprint = {{0.2, 0.2}, {-0.2, 0.2}, {-0.2, -0.2}, {0.2, -0.2}};
-  DiffDrive robot(drive_params, footprint, start, seed);
+  return DiffDrive(drive_params, footprint, start, seed);
+}
+
+/// Drives `run_m` metres along +x from `start` (world frame) at kSpeed, scanning at 10 Hz.
+RunResult driveStraight(const World2D& world, const Eigen::Vector3d& start, double slip, unsigned seed,
+                        double run_m = kRun) {
+  DiffDrive robot = mbotDrive(start, slip, seed);
   GraphSlam slam(exploreParams());
   std::mt19937 rng(seed);
   RunResult r;
@@ -182,13 +188,7 @@ TEST(StraightRuns, BackAtAPlainWallAPartialClosureMendsTheHeading) {
   // closure can be made, a partial one (the distance to the wall and the heading) can, and must
   // bring the heading back.
   const World2D w = plainWall();
-  DiffDriveParams drive_params;
-  drive_params.wheel_separation_m = 0.38;
-  drive_params.wheel_diameter_m = 0.12;
-  drive_params.wheel_acceleration_mps2 = 1.0;
-  drive_params.odometry_from_world = true;
-  const Polygon footprint = {{0.2, 0.2}, {-0.2, 0.2}, {-0.2, -0.2}, {0.2, -0.2}};
-  DiffDrive robot(drive_params, footprint, {0.0, 0.0, 0.0}, 21);
+  DiffDrive robot = mbotDrive({0.0, 0.0, 0.0}, 0.0, 21);
   GraphSlam slam(exploreParams());
   std::mt19937 rng(21);
   const double bias = 0.15 * M_PI / 180.0;  // [rad/m]

@@ -449,6 +449,12 @@ class GraphSlam : public SlamBackend {
   // returns): a few returns of a wall at the laser's reach pin nothing for sure. A direction below
   // this is open: weighed against odometry's prediction (matchLocally).
   static constexpr double kMinPinnedReturns = 10.0;
+  // The curvatures [score/m^2] at and above which a direction of a match of `returns` returns in a
+  // grid of kernel `sigma` [m] is pinned, and below which it is open (the two rules above).
+  static double pinnedCurvature(double returns, double sigma) {
+    return std::max(kConstrainedShare, kMinPinnedReturns / returns) / (sigma * sigma);
+  }
+  static double openCurvature(double returns, double sigma) { return kMinPinnedReturns / returns / (sigma * sigma); }
   // One match's squared innovation enters odometry's record clipped at this many times the record's
   // mean (3 sigma): a single wrong match must not make good odometry look bad.
   static constexpr double kInnovationClip = 9.0;
