@@ -1,8 +1,12 @@
+#include <atomic>
+#include <chrono>
 #include <limits>
+#include <thread>
 
 #include <gtest/gtest.h>
 
 #include "../../../src/nodes/ros_conversions.h"
+#include "../../../src/nodes/sim_rate.h"
 
 TEST(RosConversions, ScanKeepsRep117Ranges) {
   sensor_msgs::LaserScan msg;
@@ -48,4 +52,26 @@ TEST(RosConversions, GridInfoAndData) {
   ASSERT_EQ(msg.data.size(), 12u);
   EXPECT_EQ(msg.data[2 * 4 + 1], 99);
   EXPECT_EQ(msg.data[0], -1);
+}
+
+// A clock that goes back while the loop works (reset_simulation during a move_base cycle): the
+// next wait is one period of the new clock, not the whole jump back.
+TEST(SimRate, AClockThatWentBackDuringTheWorkIsWaitedForOnePeriod) {
+  ros::Time::init();  // simulated time, set by hand below
+  ros::Time::setNow(ros::Time(500.0));
+  mbot::ros_glue::SimRate rate(10.0);  // the first wait ends at 500.1
+  ros::Time::setNow(ros::Time(0.5));   // the reset, during the cycle's work
+  std::atomic<bool> done{false};
+  std::thread clock([&] {  // the simulator's /clock: 0.02 s a millisecond, up to 520 s at most
+    for (double t = 0.5; !done && t < 520.0; t += 0.02) {
+      ros::Time::setNow(ros::Time(t));
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  rate.sleep();
+  const double woke = ros::Time::now().toSec();
+  done = true;
+  clock.join();
+  EXPECT_LT(woke, 1.0) << "the wait went on until the clock came back to where it was before the jump";
+  EXPECT_GE(woke, 0.55);
 }
