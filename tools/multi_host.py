@@ -11,7 +11,8 @@ down at the end, also on a failure or Ctrl-C.
 --netem applies tc netem to every robot's link; --cut ROBOT:AT:FOR takes ROBOT's link down AT
 seconds (wall) after the robots start, for FOR seconds. Prints the team's one line and the bytes
 each robot's link carried (both directions, TCPROS and the master's XML-RPC) per simulated and per
-wall second; adds them to the team's report.json (`link`). Exit status 0 only for outcome
+wall second, and the message bytes of the robot's stack apart from the simulator's streams (which
+stay on board a real robot); adds them to the team's report.json (`link`). Exit status 0 only for outcome
 `complete`. Needs root (ip netns). `make demo ROBOTS=N HOSTS=separate` runs it.
 """
 import argparse
@@ -91,14 +92,40 @@ class Hosts:
         self.made = []
 
 
-def topic_bytes(hosts: Hosts, k: int) -> Dict[str, int]:
-    """{topic: message bytes} between robot k's nodes and other hosts' (bus_traffic, run on the base)."""
+SIMULATOR = '/gazebo'  # empty_world.launch's simulator node: its streams stay on board a real robot
+
+
+def topic_bytes(hosts: Hosts, k: int) -> Dict[str, Dict[str, int]]:
+    """{peer node: {topic: message bytes}} between robot k's nodes and other hosts' (bus_traffic, run
+    on the base)."""
     out = run(sys.executable, '-m', 'mbot_slam_navigation.bus_traffic', '--master', MASTER_URI,
-              '--host', hosts.ips[k], ns=hosts.base, check=False)
+              '--host', hosts.ips[k], '--by-peer', ns=hosts.base, check=False)
     try:
         return json.loads(out)
     except ValueError:
         return {}
+
+
+def link_figures(link_bytes: int, by_peer: Dict[str, Dict[str, int]], sim: float, wall: float) -> dict:
+    """A robot's link in the team's report: the interface's bytes (both ways, TCP/IP included) per
+    simulated and wall second, and message bytes per topic; `stack_kB_per_s` counts the messages
+    between the robot's stack and the base's nodes other than the simulator: what crosses the link
+    of a real robot, whose sensors, odometry and clock are on board."""
+    topics: Dict[str, int] = {}
+    for by_topic in by_peer.values():
+        for t, b in by_topic.items():
+            topics[t] = topics.get(t, 0) + b
+    stack = sum(b for peer, by_topic in by_peer.items() if peer != SIMULATOR for b in by_topic.values())
+    per_s = (lambda b: round(b / 1000.0 / sim, 2)) if sim > 0 else (lambda b: None)
+    return {
+        'bytes': link_bytes,
+        'link_kB_per_s': round(link_bytes / 1000.0 / sim, 1) if sim > 0 else None,
+        'link_kB_per_wall_s': round(link_bytes / 1000.0 / wall, 1),
+        'stack_kB_per_s': per_s(stack),
+        'simulator_kB_per_s': per_s(sum(by_peer.get(SIMULATOR, {}).values())),
+        # message bytes per topic over the robot's connections to other hosts (the nodes' counters)
+        'topics_kB_per_s': {t: per_s(b) for t, b in sorted(topics.items(), key=lambda tb: -tb[1])
+                            if sim > 0 and b > 0}}
 
 
 def start(ns: str, ip: str, args: List[str], log: str) -> subprocess.Popen:
@@ -214,14 +241,8 @@ def main(argv=None) -> int:
             figures = json.load(f)
         sim = float(figures.get('total_time_s') or 0.0)
         figures['hosts'] = 'separate'
-        figures['link'] = {('robot%d' % (k + 1)): {
-            'bytes': link_bytes[k],
-            'link_kB_per_s': round(link_bytes[k] / 1000.0 / sim, 1) if sim > 0 else None,
-            'link_kB_per_wall_s': round(link_bytes[k] / 1000.0 / wall, 1),
-            # message bytes per topic over the robot's connections to other hosts (the nodes' counters)
-            'topics_kB_per_s': {t: round(b / 1000.0 / sim, 2) for t, b in
-                                sorted(topics[k].items(), key=lambda tb: -tb[1]) if sim > 0 and b > 0}}
-            for k in range(a.robots)}
+        figures['link'] = {'robot%d' % (k + 1): link_figures(link_bytes[k], topics[k], sim, wall)
+                           for k in range(a.robots)}
         if cut:
             figures['link_cut'] = {'robot': 'robot%d' % (cut[0] + 1), 'at_wall_s': cut[1], 'for_s': cut[2]}
         if a.netem:
@@ -236,8 +257,10 @@ def main(argv=None) -> int:
                  100 * float(figures.get('coverage_of_reachable_free') or 0),
                  100 * float(figures.get('walls_within_tolerance') or 0), a.robots, figures.get('collisions', 0)))
         for name, link in figures['link'].items():
-            print('  %s link: %.1f kB per simulated s, %.1f kB per wall s (both ways); most: %s'
-                  % (name, link['link_kB_per_s'] or 0.0, link['link_kB_per_wall_s'],
+            print('  %s link: %.1f kB per simulated s, %.1f kB per wall s (both ways); messages of the stack %.1f kB '
+                  'per simulated s, of the simulator %.1f; most: %s'
+                  % (name, link['link_kB_per_s'] or 0.0, link['link_kB_per_wall_s'], link['stack_kB_per_s'] or 0.0,
+                     link['simulator_kB_per_s'] or 0.0,
                      ', '.join('%s %.1f' % tb for tb in list(link['topics_kB_per_s'].items())[:5])))
         return 0 if figures.get('outcome') == 'complete' else 1
     except KeyboardInterrupt:

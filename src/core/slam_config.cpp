@@ -12,6 +12,14 @@ SlamConfig readSlamConfig(const ParamValue& values, const std::string& ns, const
   c.odom_frame = r.frame("odom_frame", c.odom_frame, "the odometry frame");
   c.map_frame = r.frame("map_frame", c.map_frame, "the map frame, parent of odom_frame");
   c.map_update_interval = r.number("map_update_interval", c.map_update_interval, "[s] how often the map is published", 0.0);
+  c.publish_updates = r.boolean("publish_updates", c.publish_updates,
+                                "ours: publish what changed on map_updates (map_msgs/OccupancyGridUpdate) and the whole "
+                                "map only when it grows (by 4 m blocks), a subscriber comes or whole_map_period passes: "
+                                "for map_merge on another host (its robot_map_updates_topic)");
+  c.whole_map_period = r.number("whole_map_period", c.whole_map_period,
+                                "[s] ours: with publish_updates, the whole map at least this often, so that a subscriber "
+                                "that lost an update is whole again",
+                                std::nullopt, true);
   c.transform_publish_period = r.number("transform_publish_period", c.transform_publish_period,
                                         "[s] how often map -> odom is broadcast (0: only after each processed scan)", 0.0);
   c.occ_thresh = r.number("occ_thresh", c.occ_thresh, "occupancy above which a published cell is occupied (100)", 0.0);

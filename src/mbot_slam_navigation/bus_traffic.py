@@ -2,10 +2,11 @@
 node on that host and a node elsewhere, from the nodes' own counters (the slave API's getBusInfo
 and getBusStats, which roscpp and rospy both serve).
 
-    python3 -m mbot_slam_navigation.bus_traffic --master http://10.211.0.1:11311 --host 10.211.0.11
+    python3 -m mbot_slam_navigation.bus_traffic --master http://10.211.0.1:11311 --host 10.211.0.11 [--by-peer]
 
 prints a JSON object {topic: bytes} (message bytes as the nodes count them, since each node
-started; TCP/IP headers not included). Run it where the master and the host's nodes can be reached.
+started; TCP/IP headers not included), or with --by-peer {peer node: {topic: bytes}}, the peer
+being the node on the other host. Run it where the master and the host's nodes can be reached.
 """
 import argparse
 import json
@@ -29,6 +30,16 @@ def _host_of(uri: str) -> str:
 
 def host_traffic(master_uri: str, host_ip: str, timeout: float = 5.0) -> Dict[str, int]:
     """{topic: bytes} over the connections between nodes at `host_ip` and nodes at other addresses."""
+    out: Dict[str, int] = {}
+    for topics in host_traffic_by_peer(master_uri, host_ip, timeout).values():
+        for topic, n in topics.items():
+            out[topic] = out.get(topic, 0) + n
+    return out
+
+
+def host_traffic_by_peer(master_uri: str, host_ip: str, timeout: float = 5.0) -> Dict[str, Dict[str, int]]:
+    """{peer node: {topic: bytes}} over the connections between nodes at `host_ip` and nodes at
+    other addresses ('?' for a peer the master no longer knows)."""
     master = master_proxy(master_uri, timeout)
     code, _, state = master.getSystemState(CALLER)
     if code != 1:
@@ -40,8 +51,8 @@ def host_traffic(master_uri: str, host_ip: str, timeout: float = 5.0) -> Dict[st
         if code == 1:
             uris[n] = uri
     hosts = {n: _host_of(u) for n, u in uris.items()}
-    by_uri_host = {u.rstrip('/'): hosts[n] for n, u in uris.items()}
-    out: Dict[str, int] = {}
+    node_of_uri = {u.rstrip('/'): n for n, u in uris.items()}
+    out: Dict[str, Dict[str, int]] = {}
     for n, uri in uris.items():
         if hosts[n] != host_ip:
             continue
@@ -53,22 +64,22 @@ def host_traffic(master_uri: str, host_ip: str, timeout: float = 5.0) -> Dict[st
             continue  # the node ended, or does not serve the stats
         # rospy answers [code, text, stats]; roscpp the stats alone. Publications are
         # [topic, (rospy: data sent,) connections], subscriptions [topic, connections]; each
-        # connection [id, bytes, ...].
+        # connection [id, bytes, ...]. A connection's destination is the peer's URI or its name.
         if len(stats) == 3 and isinstance(stats[0], int):
             stats = stats[2]
         pub_stats, sub_stats = stats[0], stats[1]
-        # connection id -> (topic, the peer's address)
-        peers = {}
+        peers = {}  # connection id -> (the peer node, its address)
         for conn in info:
-            conn_id, dest, topic = conn[0], str(conn[1]), conn[4]
-            peer = by_uri_host.get(dest.rstrip('/')) or hosts.get(dest) or (_host_of(dest) if '://' in dest else '')
-            peers[conn_id] = (topic, peer)
+            conn_id, dest = conn[0], str(conn[1])
+            peer = node_of_uri.get(dest.rstrip('/'), dest if dest in hosts else '?')
+            peers[conn_id] = (peer, hosts.get(peer) or (_host_of(dest) if '://' in dest else ''))
         for entry in list(pub_stats) + list(sub_stats):
             topic, conns = entry[0], entry[-1]
             for c in conns:
-                _, peer = peers.get(c[0], (topic, ''))
-                if peer and peer != host_ip:
-                    out[topic] = out.get(topic, 0) + int(c[1])
+                peer, address = peers.get(c[0], ('?', ''))
+                if address and address != host_ip:
+                    by_topic = out.setdefault(peer, {})
+                    by_topic[topic] = by_topic.get(topic, 0) + int(c[1])
     return out
 
 
@@ -76,9 +87,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('--master', required=True)
     ap.add_argument('--host', required=True, help="the host's address")
+    ap.add_argument('--by-peer', action='store_true', help='{peer node: {topic: bytes}}')
     a = ap.parse_args(argv)
     try:
-        print(json.dumps(host_traffic(a.master, a.host)))
+        print(json.dumps((host_traffic_by_peer if a.by_peer else host_traffic)(a.master, a.host)))
     except (OSError, RuntimeError) as e:
         print('bus_traffic: %s' % e, file=sys.stderr)
         return 2

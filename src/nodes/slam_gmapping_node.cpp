@@ -5,7 +5,9 @@
 // track).
 //
 // Subscribes `scan` (with tf from its frame to ~base_frame and from ~base_frame to ~odom_frame);
-// publishes `map`, `map_metadata` (latched) every ~map_update_interval, `~entropy` (rbpf only: the
+// publishes `map`, `map_metadata` (latched) every ~map_update_interval (with ~publish_updates, the
+// whole map only when it grows, a subscriber comes or ~whole_map_period passes, and what changed in
+// between on `map_updates`, map_msgs/OccupancyGridUpdate), `~entropy` (rbpf only: the
 // graph has no particle cloud), `~match_weakest_sigma` (std_msgs/Float64 [m], every tracked scan
 // while someone listens: the standard deviation of the scan's match along the direction it
 // constrains least; about 1 cm in a room, 5 cm or more along a plain corridor, where odometry gives
@@ -37,6 +39,7 @@
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/GetMap.h>
 #include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -49,6 +52,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "mbot_slam_navigation/core/graph_slam.h"
+#include "mbot_slam_navigation/core/map_updates.h"
 #include "mbot_slam_navigation/core/pose2d.h"
 #include "mbot_slam_navigation/core/rbpf_slam.h"
 #include "mbot_slam_navigation/core/slam_config.h"
@@ -77,7 +81,20 @@ class SlamGmappingNode {
       ROS_FATAL("slam_gmapping: %s", e.what());
       throw;
     }
-    map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+    if (publish_updates_) {
+      // A new subscriber gets the latched whole map, older than the updates sent since, and then
+      // (it alone) the newest map whole, which later updates apply to.
+      map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>(
+          "map", 1,
+          [this](const ros::SingleSubscriberPublisher& one) {
+            std::lock_guard<std::mutex> lock(map_mutex_);
+            if (last_map_) one.publish(*last_map_);
+          },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
+      updates_pub_ = nh_.advertise<map_msgs::OccupancyGridUpdate>("map_updates", 100);
+    } else {
+      map_pub_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+    }
     meta_pub_ = nh_.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
     entropy_pub_ = pnh_.advertise<std_msgs::Float64>("entropy", 1, true);
     weakest_pub_ = pnh_.advertise<std_msgs::Float64>("match_weakest_sigma", 10);
@@ -142,6 +159,8 @@ class SlamGmappingNode {
     odom_frame_ = c.odom_frame;
     map_frame_ = c.map_frame;
     map_update_interval_ = c.map_update_interval;
+    publish_updates_ = c.publish_updates;
+    whole_map_period_ = c.whole_map_period;
     transform_publish_period_ = c.transform_publish_period;
     occ_thresh_ = c.occ_thresh;
     throttle_scans_ = c.throttle_scans;
@@ -416,20 +435,29 @@ class SlamGmappingNode {
     // Published as a shared message: one serialization for every subscriber, and dynamic_map
     // answers from the same message without another copy of megabytes.
     auto map = boost::make_shared<nav_msgs::OccupancyGrid>();
+    mbot::core::OccupancyImage image;
     if (backend_ == "graph") {
-      mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), *map);
+      image = slam_->occupancy(occ_thresh_);
     } else {
       std::lock_guard<std::mutex> lock(mutex_);
-      mbot::ros_glue::toRos(slam_->occupancy(occ_thresh_), *map);
+      image = slam_->occupancy(occ_thresh_);
     }
+    if (publish_updates_) image = mbot::core::paddedToBlocks(std::move(image), blockCells(image.resolution));
+    mbot::ros_glue::toRos(std::move(image), *map);
     map->header.frame_id = map_frame_;
     map->header.stamp = stamp;
     map->info.map_load_time = stamp;
     {
       std::lock_guard<std::mutex> lock(map_mutex_);
+      const bool whole = !publish_updates_ || sendsWhole(*map, stamp);
+      if (whole) {
+        map_pub_.publish(map);
+        meta_pub_.publish(map->info);
+        whole_sent_at_ = stamp;
+      } else {
+        publishUpdates(*map, stamp);
+      }
       last_map_ = map;
-      map_pub_.publish(last_map_);
-      meta_pub_.publish(map->info);
     }
     // A map rebuild and an optimization allocate and free megabytes; glibc keeps freed pages in
     // the middle of the heap, so a node left running for hours would show its peaks, not its use.
@@ -439,6 +467,44 @@ class SlamGmappingNode {
         (stamp - last_trim_).toSec() >= kTrimPeriod) {
       malloc_trim(0);
       last_trim_ = stamp;
+    }
+  }
+
+  /// With ~publish_updates: the map grows by blocks of this many cells (4 m), so that whole maps
+  /// are sent seldom.
+  static int blockCells(double resolution) { return std::max(1, static_cast<int>(std::lround(4.0 / resolution))); }
+
+  /// With ~publish_updates: whether `map` goes whole (its size or origin changed,
+  /// ~whole_map_period passed, or the clock went back); map_mutex_ held.
+  bool sendsWhole(const nav_msgs::OccupancyGrid& map, const ros::Time& stamp) {
+    const auto& a = map.info;
+    if (!last_map_ || whole_sent_at_.isZero() || stamp < whole_sent_at_ ||
+        (stamp - whole_sent_at_).toSec() >= whole_map_period_) {
+      return true;
+    }
+    const auto& b = last_map_->info;
+    return a.width != b.width || a.height != b.height || a.resolution != b.resolution ||
+           a.origin.position.x != b.origin.position.x || a.origin.position.y != b.origin.position.y;
+  }
+
+  /// What changed since the last map, as map_msgs/OccupancyGridUpdate windows on map_updates (the
+  /// tiles of 16 x 16 cells that changed, runs of them along a row in one window); map_mutex_ held.
+  void publishUpdates(const nav_msgs::OccupancyGrid& map, const ros::Time& stamp) {
+    const int width = static_cast<int>(map.info.width), height = static_cast<int>(map.info.height);
+    for (const auto& w : mbot::core::changedWindows(last_map_->data, map.data, width, height, kUpdateTile)) {
+      map_msgs::OccupancyGridUpdate up;
+      up.header.frame_id = map_frame_;
+      up.header.stamp = stamp;
+      up.x = w.x;
+      up.y = w.y;
+      up.width = w.width;
+      up.height = w.height;
+      up.data.reserve(static_cast<size_t>(w.width) * w.height);
+      for (int r = w.y; r < w.y + w.height; ++r) {
+        const auto row = map.data.begin() + static_cast<long>(r) * width;
+        up.data.insert(up.data.end(), row + w.x, row + w.x + w.width);
+      }
+      updates_pub_.publish(up);
     }
   }
 
@@ -656,7 +722,11 @@ class SlamGmappingNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
-  ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_;
+  ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_, updates_pub_;
+  bool publish_updates_ = false;
+  double whole_map_period_ = 60.0;  // [s]
+  ros::Time whole_sent_at_;             // when `map` was last published whole (map_mutex_)
+  static constexpr int kUpdateTile = 16;  // [cells] the tiles of map_updates' windows
   ros::Subscriber scan_sub_, initial_pose_sub_;
   ros::ServiceServer map_srv_, serialize_srv_, deserialize_srv_;
   // Sessions (slam_config.h).
@@ -685,7 +755,7 @@ class SlamGmappingNode {
   double correction_threshold_ = 0.0;
   std::unique_ptr<mbot::core::SlamBackend> slam_;  // replaced in the scan callback only
   Eigen::Vector3d map_to_odom_ = Eigen::Vector3d::Zero();
-  nav_msgs::OccupancyGrid::ConstPtr last_map_;  // as published; never changed after
+  nav_msgs::OccupancyGrid::ConstPtr last_map_;  // the newest map (whole or sent as updates); never changed after
   ros::Time last_stamp_, last_map_update_;
   long scan_count_ = 0;
   mbot::ros_glue::SeqGapCounter scan_gaps_;  // scans roscpp dropped from the full queue

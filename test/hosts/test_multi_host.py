@@ -1,6 +1,7 @@
 """Two robots on two hosts of their own and a base station (tools/multi_host.py: network namespaces
 joined by a bridge, one master on the base, ROS_IP on every host) explore the home together; the
-team's report gives each robot's link traffic, and nothing of the run is left behind. Needs root
+team's report gives each robot's link traffic (what its stack sends apart from the simulator's
+streams), and nothing of the run is left behind. Needs root
 (ip netns) and the built workspace; make test runs it after the unit tests."""
 import json
 import os
@@ -39,4 +40,10 @@ def test_two_robots_on_their_own_hosts_explore_the_home(tmp_path):
         link = r['link'][name]
         # each robot's stack talked to the base over its own link: the merged map, tf, the team
         assert link['bytes'] > 100000, link
+        topics = link['topics_kB_per_s']
+        # its own map goes to map_merge as updates between whole maps; only its own transforms
+        # cross (its stack's tf is in its namespace), not every robot's /tf
+        assert '/%s/map_updates' % name in topics, topics
+        assert '/tf' not in topics and '/%s/tf' % name in topics, topics
+        assert 0 < link['stack_kB_per_s'] < link['link_kB_per_s'], link
         assert r['per_robot'][name]['outcome'] == 'complete'

@@ -7,7 +7,8 @@ the lag of the slowest node that auto aims below; defaults in sim/pacing.py), ma
 under auto, the longest the clock waits for a node whose heartbeat is due; 0 never waits), step_size (0.01 s),
 pub_clock_frequency (100 Hz of simulated time), paused (false), gui (false), odometry_slip_stddev
 (0.02, relative, for encoder odometry), cmd_vel_timeout (0.5 s), seed (0), gazebo_namespace
-("gazebo": where services and the contacts topic live).
+("gazebo": where services and the contacts topic live), robot_tf_in_namespace (false: a namespaced
+robot's transforms on <namespace>/tf instead of /tf).
 
 Publishes /clock; per robot (in its namespace): the drive's odometry topic and odom -> base tf,
 each laser's LaserScan, base_pose_ground_truth (nav_msgs/Odometry in the world frame). Services
@@ -76,10 +77,13 @@ class RobotIO:
         self.scan_pubs = [nonblocking_publisher(topic(l.spec.topic), LaserScan) for l in robot.lasers]
         self.cmd_topic = topic(drive.command_topic)
         self.cmd_sub = rospy.Subscriber(self.cmd_topic, Twist, node.on_cmd_vel, callback_args=robot.name, queue_size=5)
+        # the robot's own tf topic (robot_tf_in_namespace), else the node's /tf
+        self.own_tf_pub = nonblocking_publisher(prefix + 'tf', TFMessage) if node.robot_tf_in_namespace and ns else None
+        self.tf_pub = self.own_tf_pub or node.tf_pub
 
     def close(self):
         self.cmd_sub.unregister()
-        for p in [self.odom_pub, self.truth_pub] + self.scan_pubs:
+        for p in [self.odom_pub, self.truth_pub] + self.scan_pubs + ([self.own_tf_pub] if self.own_tf_pub else []):
             p.unregister()
 
 
@@ -114,6 +118,11 @@ def read_parameters(r: ParamReader) -> dict:
     c['cmd_vel_timeout'] = r.number('cmd_vel_timeout', 0.5, '[s] ours: the robot stops when cmd_vel falls silent this '
                                     'long (0: never)', minimum=0.0)
     c['seed'] = r.integer('seed', 0, "ours: the random generator's seed (slip, laser noise)")
+    c['robot_tf_in_namespace'] = r.boolean(
+        'robot_tf_in_namespace', False,
+        "ours: a namespaced robot's odom -> base and wheel transforms go on <namespace>/tf instead of /tf, for robot "
+        "stacks that remap /tf into their namespace (launch/robot.launch), so that a robot on a host of its own is not "
+        "sent every robot's transforms; relay them to /tf for rviz (launch/base_station.launch)")
     return c
 
 
@@ -129,6 +138,7 @@ class SimNode:
         self.paused = c['paused']
         self.gui = c['gui']
         self.gz_ns = '/' + c['gazebo_namespace'].strip('/')
+        self.robot_tf_in_namespace = c['robot_tf_in_namespace']
         world_path = c['world_name']
         if world_path:
             world = load_world(world_path, c['map_unknown'])  # raises XmlError or MapFileError naming the file
@@ -351,7 +361,7 @@ class SimNode:
             if robot.spec.drive.publish_wheel_tf:
                 transforms += self.wheel_transforms(robot, stamp)
             if transforms:
-                self.tf_pub.publish(TFMessage(transforms))
+                io.tf_pub.publish(TFMessage(transforms))
         for k in due_lasers:
             laser = robot.lasers[k]
             s = laser.spec
