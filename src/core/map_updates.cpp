@@ -32,16 +32,27 @@ struct Box {
 };
 }  // namespace
 
-OccupancyImage paddedToBlocks(OccupancyImage image, int block_cells) {
+GridWindow frameCells(const OccupancyImage& image) {
+  if (image.resolution <= 0.0) return GridWindow{0, 0, image.width, image.height};
+  return GridWindow{static_cast<int>(std::floor(image.origin.x() / image.resolution + 1e-6)),
+                    static_cast<int>(std::floor(image.origin.y() / image.resolution + 1e-6)), image.width, image.height};
+}
+
+OccupancyImage paddedToBlocks(OccupancyImage image, int block_cells, const GridWindow* cover) {
   if (block_cells < 1) throw std::invalid_argument("paddedToBlocks: block_cells must be at least 1");
   if (image.width <= 0 || image.height <= 0 || image.resolution <= 0.0) return image;
-  // The image's first cell in the frame's cells (its origin lies on a cell corner of the frame).
-  const int c0 = static_cast<int>(std::floor(image.origin.x() / image.resolution + 1e-6));
-  const int r0 = static_cast<int>(std::floor(image.origin.y() / image.resolution + 1e-6));
-  const int left = c0 - floorDiv(c0, block_cells) * block_cells;
-  const int bottom = r0 - floorDiv(r0, block_cells) * block_cells;
-  const int width = (left + image.width + block_cells - 1) / block_cells * block_cells;
-  const int height = (bottom + image.height + block_cells - 1) / block_cells * block_cells;
+  const GridWindow own = frameCells(image);
+  // The padded window in the frame's cells: [x0, x1) x [y0, y1).
+  int x0 = floorDiv(own.x, block_cells) * block_cells, y0 = floorDiv(own.y, block_cells) * block_cells;
+  int x1 = -floorDiv(-(own.x + own.width), block_cells) * block_cells;
+  int y1 = -floorDiv(-(own.y + own.height), block_cells) * block_cells;
+  if (cover && cover->width > 0 && cover->height > 0) {
+    x0 = std::min(x0, cover->x);
+    y0 = std::min(y0, cover->y);
+    x1 = std::max(x1, cover->x + cover->width);
+    y1 = std::max(y1, cover->y + cover->height);
+  }
+  const int left = own.x - x0, bottom = own.y - y0, width = x1 - x0, height = y1 - y0;
   if (left == 0 && bottom == 0 && width == image.width && height == image.height) return image;
   OccupancyImage out;
   out.width = width;

@@ -442,7 +442,13 @@ class SlamGmappingNode {
       std::lock_guard<std::mutex> lock(mutex_);
       image = slam_->occupancy(occ_thresh_);
     }
-    if (publish_updates_) image = mbot::core::paddedToBlocks(std::move(image), blockCells(image.resolution));
+    if (publish_updates_) {
+      // Grown by blocks and never shrunk (but for a new map after the clock went back): each change
+      // of size sends the whole map.
+      const bool keep = last_map_ && stamp >= last_map_->header.stamp;
+      image = mbot::core::paddedToBlocks(std::move(image), blockCells(image.resolution), keep ? &covered_ : nullptr);
+      covered_ = mbot::core::frameCells(image);
+    }
     mbot::ros_glue::toRos(std::move(image), *map);
     map->header.frame_id = map_frame_;
     map->header.stamp = stamp;
@@ -726,6 +732,7 @@ class SlamGmappingNode {
   bool publish_updates_ = false;
   double whole_map_period_ = 60.0;  // [s]
   ros::Time whole_sent_at_;             // when `map` was last published whole (map_mutex_)
+  mbot::core::GridWindow covered_;      // the frame's cells the last map covered (publish_updates)
   static constexpr int kUpdateTile = 16;  // [cells] the tiles of map_updates' windows
   ros::Subscriber scan_sub_, initial_pose_sub_;
   ros::ServiceServer map_srv_, serialize_srv_, deserialize_srv_;

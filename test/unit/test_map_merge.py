@@ -145,6 +145,13 @@ def test_a_map_padded_to_blocks_keeps_its_cells_in_place_and_grows_by_blocks():
     p2 = padded_to_blocks(m2, 0.2)
     assert p2.data.shape == p.data.shape and p2.origin == pytest.approx(p.origin)
     assert p.origin == pytest.approx((-0.4, 0.0))  # block edges: multiples of 0.2 m
+    # an edge that went out across a block's edge and back: covering what was sent, the size stays
+    wide = padded_to_blocks(Grid(np.zeros((7, 10), np.int8), 0.05, (-0.45, 0.15)), 0.2)
+    assert wide.data.shape[1] > p.data.shape[1]
+    kept = padded_to_blocks(m, 0.2, cover=wide)
+    assert kept.data.shape == wide.data.shape and kept.origin == pytest.approx(wide.origin)
+    r, c = kept.cell_of(m.centre_of(3, 5)[0], m.centre_of(3, 5)[1])
+    assert kept.data[r, c] == data[3, 5]
 
 
 def test_changes_far_apart_go_in_windows_of_their_own():

@@ -84,4 +84,18 @@ TEST(MapUpdates, PaddedToBlocksKeepsTheCellsWhereTheyAreAndItsSizeWhileTheyStayI
   EXPECT_EQ(q.height, p.height);
   EXPECT_NEAR(q.origin.x(), p.origin.x(), 1e-9);
   EXPECT_THROW(paddedToBlocks(m, 0), std::invalid_argument);
+  // A map whose edge went back across a block's edge (frame cells -9..-1 and back to -7..-1):
+  // covering what was sent, it keeps its size; without, it would shrink and be sent whole again.
+  OccupancyImage wider = m;
+  wider.width = 9;
+  wider.origin.x() = -0.45;
+  wider.data.assign(45, 0);
+  const auto sent = mbot::core::frameCells(paddedToBlocks(wider, 8));
+  EXPECT_EQ(sent.x, -16);
+  EXPECT_EQ(sent.width, 16);
+  const auto kept = paddedToBlocks(m, 8, &sent);
+  EXPECT_EQ(mbot::core::frameCells(kept).x, sent.x);
+  EXPECT_EQ(kept.width, sent.width);
+  EXPECT_EQ(kept.height, sent.height);
+  EXPECT_EQ(paddedToBlocks(m, 8).width, 8);
 }

@@ -18,9 +18,14 @@ struct GridWindow {
 
 /// `image` grown with unknown cells (-1) to whole blocks of `block_cells` x `block_cells`, aligned
 /// on the cells of its frame (cell (0, 0) has its corner at the frame's origin), so that its size
-/// and origin change only when what it holds crosses a block's edge. Throws std::invalid_argument
-/// for block_cells < 1.
-OccupancyImage paddedToBlocks(OccupancyImage image, int block_cells);
+/// and origin change only when what it holds crosses a block's edge; and, with `cover` (a window
+/// in the frame's cells, e.g. the map last sent), grown to cover that too, so that a map whose
+/// edge moves back and forth across a block's edge (an optimization moving a wall by a cell) keeps
+/// its size. Throws std::invalid_argument for block_cells < 1.
+OccupancyImage paddedToBlocks(OccupancyImage image, int block_cells, const GridWindow* cover = nullptr);
+
+/// The window of the frame's cells that `image` covers (its origin on a cell corner of the frame).
+GridWindow frameCells(const OccupancyImage& image);
 
 /// Windows covering every cell where `after` differs from `before` (width x height cells each,
 /// row-major): the grid is cut into tiles of `tile` x `tile` cells, each shrunk to its changed

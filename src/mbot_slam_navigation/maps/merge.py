@@ -163,17 +163,24 @@ def clear_swept(m: Grid, trails: Sequence[Sequence[Tuple[float, float]]], radius
     return Grid(data, m.resolution, m.origin)
 
 
-def padded_to_blocks(m: Grid, block: float) -> Grid:
+def padded_to_blocks(m: Grid, block: float, cover: Optional[Grid] = None) -> Grid:
     """`m` grown with unknown cells to whole blocks of `block` [m] aligned on the world origin, so that
-    its size and origin change only when the explored part crosses a block's edge."""
+    its size and origin change only when the explored part crosses a block's edge; and to cover
+    `cover` (the map last sent, same resolution) too, so that a map whose edge goes back and forth
+    across a block's edge keeps its size."""
     n = max(1, int(round(block / m.resolution)))
     c0 = int(np.floor(m.origin[0] / m.resolution + 1e-6))
     r0 = int(np.floor(m.origin[1] / m.resolution + 1e-6))
-    left, bottom = c0 - (c0 // n) * n, r0 - (r0 // n) * n
     h, w = m.data.shape
-    right = (-(left + w)) % n
-    top = (-(bottom + h)) % n
-    data = np.pad(m.data, ((bottom, top), (left, right)), constant_values=-1)
+    lo_c, lo_r = (c0 // n) * n, (r0 // n) * n
+    hi_c, hi_r = -((-(c0 + w)) // n) * n, -((-(r0 + h)) // n) * n
+    if cover is not None:
+        cc = int(np.floor(cover.origin[0] / cover.resolution + 1e-6))
+        cr = int(np.floor(cover.origin[1] / cover.resolution + 1e-6))
+        lo_c, lo_r = min(lo_c, cc), min(lo_r, cr)
+        hi_c, hi_r = max(hi_c, cc + cover.data.shape[1]), max(hi_r, cr + cover.data.shape[0])
+    left, bottom = c0 - lo_c, r0 - lo_r
+    data = np.pad(m.data, ((bottom, hi_r - r0 - h), (left, hi_c - c0 - w)), constant_values=-1)
     origin = (m.origin[0] - left * m.resolution, m.origin[1] - bottom * m.resolution) + tuple(m.origin[2:])
     return Grid(data, m.resolution, origin)
 
