@@ -7,8 +7,10 @@ down at the end, also on a failure or Ctrl-C.
 
     tools/multi_host.py --robots 2 --report-dir report [--world FILE] [--spawn x,y[,yaw] ...]
         [--max-duration S] [--launch-arg name:=value ...] [--netem "delay 100ms loss 2%"] [--cut robot2:60:10]
+        [--kill robot3:60]
 
---netem applies tc netem to every robot's link; --cut ROBOT:AT:FOR takes ROBOT's link down AT
+--netem applies tc netem to every robot's link; --kill ROBOT:AT kills everything ROBOT's host runs
+(SIGKILL) AT seconds (wall) after the robots start, as a host that dies; --cut ROBOT:AT:FOR takes ROBOT's link down AT
 seconds (wall) after the robots start, for FOR seconds. Prints the team's one line and the bytes
 each robot's link carried (both directions, TCPROS and the master's XML-RPC) per simulated and per
 wall second, and the message bytes of the robot's stack apart from the simulator's streams (which
@@ -137,9 +139,10 @@ def start(ns: str, ip: str, args: List[str], log: str) -> subprocess.Popen:
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
-def stop(procs: List[subprocess.Popen]) -> None:
+def stop(procs: List[subprocess.Popen],
+         signals=((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0))) -> None:
     """Ctrl-C to every roslaunch, then SIGTERM and SIGKILL to what is left of their groups."""
-    for sig, grace in ((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0)):
+    for sig, grace in signals:
         alive = [p for p in procs if p.poll() is None]
         if not alive:
             return
@@ -171,6 +174,7 @@ def main(argv=None) -> int:
     ap.add_argument('--bad-ros-ip', default='', metavar='ROBOT',
                     help='start robotK with ROS_IP=127.0.0.1 (a misconfigured host, to see it reported)')
     ap.add_argument('--cut', default='', help='ROBOT:AT:FOR: robotK link down AT s (wall) after the start, FOR s')
+    ap.add_argument('--kill', default='', help="ROBOT:AT: robotK's host dies AT s (wall) after the start")
     a = ap.parse_args(argv)
     if os.geteuid() != 0:
         print('multi_host: network namespaces need root (ip netns); run as root', file=sys.stderr)
@@ -181,6 +185,10 @@ def main(argv=None) -> int:
     if os.path.exists(report):
         os.replace(report, report + '.previous')
     cut = None
+    kill = None
+    if a.kill:
+        name, at = a.kill.split(':')
+        kill = (int(name.replace('robot', '')) - 1, float(at))
     if a.cut:
         name, at, length = a.cut.split(':')
         cut = (int(name.replace('robot', '')) - 1, float(at), float(length))
@@ -215,8 +223,14 @@ def main(argv=None) -> int:
         t0 = time.monotonic()
         start_bytes = [hosts.bytes(k) for k in range(a.robots)]
         cut_state = 'pending' if cut else None
+        killed = None
         while not os.path.exists(report):
             now = time.monotonic() - t0
+            if kill and now >= kill[1]:
+                stop([procs[1 + kill[0]]], signals=((signal.SIGKILL, 5.0),))
+                print('multi_host: robot%d host killed at %.0f s' % (kill[0] + 1, now), flush=True)
+                killed = {'robot': 'robot%d' % (kill[0] + 1), 'at_wall_s': round(now, 1)}
+                kill = None
             if cut_state == 'pending' and now >= cut[1]:
                 hosts.set_link(cut[0], False)
                 print('multi_host: robot%d link cut at %.0f s' % (cut[0] + 1, now), flush=True)
@@ -243,6 +257,8 @@ def main(argv=None) -> int:
         figures['hosts'] = 'separate'
         figures['link'] = {'robot%d' % (k + 1): link_figures(link_bytes[k], topics[k], sim, wall)
                            for k in range(a.robots)}
+        if killed:
+            figures['host_killed'] = killed
         if cut:
             figures['link_cut'] = {'robot': 'robot%d' % (cut[0] + 1), 'at_wall_s': cut[1], 'for_s': cut[2]}
         if a.netem:
@@ -262,6 +278,11 @@ def main(argv=None) -> int:
                   % (name, link['link_kB_per_s'] or 0.0, link['link_kB_per_wall_s'], link['stack_kB_per_s'] or 0.0,
                      link['simulator_kB_per_s'] or 0.0,
                      ', '.join('%s %.1f' % tb for tb in list(link['topics_kB_per_s'].items())[:5])))
+        for o in figures.get('outages', []):
+            print('  outage: %s silent from %.1f s to %s (simulated, as the base station heard it)'
+                  % (o['robot'], o['from_s'], 'the end' if o['to_s'] is None else '%.1f s' % o['to_s']))
+        if figures.get('robots_lost'):
+            print('  the team ended without %s (lost)' % ', '.join(figures['robots_lost']))
         return 0 if figures.get('outcome') == 'complete' else 1
     except KeyboardInterrupt:
         print('multi_host: interrupted; tearing down', file=sys.stderr)

@@ -265,11 +265,14 @@ def write_figures(report_dir: str, figures: Dict) -> None:
 
 def team_figures(reports: Dict[str, Dict]) -> Dict:
     """The team's figures from each robot's explorer report (by robot name): outcome `complete` only
-    if every robot's is, else the first of error, stuck, timeout, not_started found; the exploration time is
-    the last robot's; distances, goals and collisions per robot and summed."""
-    outcomes = [r.get('outcome', 'not_started') for r in reports.values()]
+    if every robot's is, robots `lost` aside (the base station stopped hearing from them; the team
+    finished without them, and `robots_lost` names them), else the first of error, stuck, timeout,
+    not_started found (`lost` when every robot is); the exploration time is the last robot's;
+    distances, goals and collisions per robot and summed."""
+    lost = sorted(name for name, r in reports.items() if r.get('outcome') == 'lost')
+    outcomes = [r.get('outcome', 'not_started') for r in reports.values() if r.get('outcome') != 'lost']
     outcome = 'complete' if outcomes and all(o == 'complete' for o in outcomes) else next(
-        (o for o in ('error', 'stuck', 'timeout', 'not_started') if o in outcomes), 'not_started')
+        (o for o in ('error', 'stuck', 'timeout', 'not_started') if o in outcomes), 'lost' if lost else 'not_started')
     per_robot = {name: {k: r.get(k) for k in ('outcome', 'exploration_time_s', 'distance_m', 'goals_sent',
                                               'goals_failed', 'collisions', 'why') if k in r or k != 'why'}
                  for name, r in sorted(reports.items())}
@@ -286,16 +289,20 @@ def team_figures(reports: Dict[str, Dict]) -> Dict:
         'collisions': int(total('collisions')),
         'per_robot': per_robot,
         'given_up': [g for r in reports.values() for g in r.get('given_up', [])],
+        'robots_lost': lost,
     }
 
 
 def write_team_report(report_dir: str, m: Grid, paths: Dict[str, List[Tuple[float, float]]],
                       curve: List[Tuple[float, float]], reports: Dict[str, Dict], world: Optional[World] = None,
-                      start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=()) -> Dict:
+                      start: Tuple[float, float] = (0.0, 0.0), robot_radius: float = 0.2, rooms=(),
+                      extra: Optional[Dict] = None) -> Dict:
     """The team's report in report_dir: the merged map (map.pgm/map.yaml), map.png with each robot's
     path in its own colour, area.png (the merged map's known area against time) and report.json
-    (team_figures, with the merged map scored against the world when given); returns the figures."""
-    figures = _map_figures(report_dir, m, team_figures(reports), world, start, robot_radius, rooms)
+    (team_figures and `extra`, with the merged map scored against the world when given); returns the
+    figures."""
+    figures = _map_figures(report_dir, m, dict(team_figures(reports), **(extra or {})), world, start, robot_radius,
+                           rooms)
     draw_team_map(m, paths, os.path.join(report_dir, 'map.png'))
     draw_area(curve, os.path.join(report_dir, 'area.png'))
     write_figures(report_dir, figures)

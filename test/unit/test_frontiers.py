@@ -531,6 +531,11 @@ def test_the_team_report_is_complete_only_when_every_robot_is():
     assert f['per_robot']['robot2']['distance_m'] == 25.5
     assert team_figures({'robot1': a, 'robot2': dict(b, outcome='timeout')})['outcome'] == 'timeout'
     assert team_figures({'robot1': a, 'robot2': {'outcome': 'not_started'}})['outcome'] == 'not_started'
+    # a robot the base station lost (its host died): the team finished without it and names it
+    lost = team_figures({'robot1': a, 'robot2': {'outcome': 'lost', 'why': 'silent'}})
+    assert lost['outcome'] == 'complete' and lost['robots_lost'] == ['robot2']
+    assert lost['per_robot']['robot2']['outcome'] == 'lost' and f['robots_lost'] == []
+    assert team_figures({'robot1': dict(a, outcome='stuck'), 'robot2': {'outcome': 'lost'}})['outcome'] == 'stuck'
 
 
 def test_the_goal_being_driven_to_stays_the_frontiers_goal_while_it_is_still_valid():

@@ -66,6 +66,29 @@ def test_two_robots_see_and_block_each_other():
     assert a.collisions == 1 and sim.get('b').pose[0] == pytest.approx(-1.5)
 
 
+def test_two_robots_driving_at_each_other_stop_apart_and_can_back_away():
+    # Head-on at 0.5 m/s each: a step closes 1 cm, so both would move into the same gap if each
+    # checked its move against where the other stood before the step (the gap, 0.297 m, is not a
+    # whole number of steps).
+    sim = Simulation(load_world(HOME), slip_stddev=0.0)
+    a = sim.spawn('a', robot_spec(), (-3.0, -2.0, 0.0))
+    b = sim.spawn('b', robot_spec(), (-2.103, -2.0, math.pi))
+    for _ in range(int(round(4.0 / sim.step_size))):
+        sim.command('a', 0.5, 0.0)
+        sim.command('b', 0.5, 0.0)
+        sim.step()
+    assert a.collisions >= 1 and b.collisions >= 1
+    gap = b.pose[0] - a.pose[0]
+    assert gap >= 0.6 - 1e-6, 'the bodies (0.3 m ahead of each centre) overlap by %.3f m' % (0.6 - gap)
+    # both back away
+    xa, xb = a.pose[0], b.pose[0]
+    for _ in range(int(round(1.0 / sim.step_size))):
+        sim.command('a', -0.2, 0.0)
+        sim.command('b', -0.2, 0.0)
+        sim.step()
+    assert a.pose[0] < xa - 0.15 and b.pose[0] > xb + 0.15, (a.pose, b.pose)
+
+
 PERSON_SDF = '''<sdf version="1.6"><world name="w">
   <actor name="walker"><script><loop>true</loop><delay_start>1.0</delay_start>
     <trajectory id="0" type="walking">

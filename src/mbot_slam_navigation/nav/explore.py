@@ -27,11 +27,11 @@ Parameters: read_parameters() (the reference page: docs/nodes/explore.md): explo
 defaults, then ours.
 
 A team (launch/multi_explore.launch): with team_topic set (e.g. /explore/team), each explorer says
-where its robot is and where it goes (mbot_slam_navigation/ExplorerState, every cycle, under
-robot_name, default its namespace) and hears the others: a frontier whose goal lies within
-claim_radius (2.0 m) of a teammate's goal is left to it, and one nearer to a teammate than to this
-robot costs more (team.share_out); of two robots heading for one place the one whose name sorts
-first keeps it. A robot whose frontiers are all claimed waits; the team's exploration is complete
+where its robot is and where it goes (mbot_slam_navigation/ExplorerState, under robot_name, default
+its namespace; every cycle and every second) and hears the others: a frontier whose goal lies
+within claim_radius (2.0 m) of a teammate's goal is left to it, and one nearer to a teammate than
+to this robot costs more (team.share_out); of two robots heading for one place the one whose name
+sorts first keeps it. A robot whose frontiers are all claimed waits; the team's exploration is complete
 for a robot when no frontier is left to anyone.
 """
 import math
@@ -333,6 +333,11 @@ class Explore:
         if team_topic:
             self.team_pub = rospy.Publisher(team_topic, ExplorerState, queue_size=10)
             rospy.Subscriber(team_topic, ExplorerState, self.on_mate, queue_size=20)
+            # Said every second besides each cycle, so that the base station (explore_team) can
+            # tell a robot that is busy (backing out, waiting) from one whose link or host is down.
+            rospy.Timer(rospy.Duration(1.0), self.heartbeat)
+        self.told_pose = None  # the pose last told the team, once exploring
+        self.ended = False
 
     def on_boundary(self, msg: PolygonStamped) -> None:
         """explore/boundary: the area to explore from now on; an empty polygon: everywhere."""
@@ -388,9 +393,15 @@ class Explore:
                 for m in list(self.mates.values())
                 if not m.done and abs((now - m.header.stamp).to_sec()) < 10.0]
 
+    def heartbeat(self, _event) -> None:
+        if self.told_pose is not None and not self.ended:
+            self.tell_team(self.told_pose)
+
     def tell_team(self, pose, done: bool = False) -> None:
         if self.team_pub is None:
             return
+        if pose is not None:
+            self.told_pose = pose
         msg = ExplorerState(robot=self.robot_name, done=done)
         msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self.global_frame
         if pose is not None:
@@ -980,6 +991,7 @@ class Explore:
         for g in figures['given_up']:
             print('  given up: (%.2f, %.2f), %.1f m: %s' % (g['x'], g['y'], g['size_m'], g['why']), flush=True)
         rospy.loginfo('explore: exploration ended (%s): %s', outcome, figures)
+        self.ended = True
         self.tell_team(self.robot_pose(), done=True)
         self.done_pub.publish(Bool(True))  # last, so that the report is on disk when it says so
 

@@ -43,3 +43,66 @@ def yields_goal(goal: Tuple[float, float], me: str, mates: Sequence[Teammate], c
     """True if a teammate whose name sorts before `me` heads for a goal within claim_radius of ours."""
     return any(m.goal is not None and m.name < me and math.hypot(goal[0] - m.goal[0], goal[1] - m.goal[1]) < claim_radius
                for m in mates)
+
+
+@dataclass
+class Outage:
+    """A robot the base station did not hear from: from its last word to its next [s, the team's
+    clock from its start]; `until` None while it is still silent."""
+    robot: str
+    since: float
+    until: Optional[float] = None
+
+    def as_dict(self, origin: float = 0.0) -> dict:
+        """For the team's report, times from `origin` [s]."""
+        return {'robot': self.robot, 'from_s': round(self.since - origin, 1),
+                'to_s': None if self.until is None else round(self.until - origin, 1),
+                'silent_s': None if self.until is None else round(self.until - self.since, 1)}
+
+
+class TeamWatch:
+    """What the base station hears of each robot (its explorer's state, ~team_topic, said every
+    second), ROS-free: a robot silent for more than `silence` [s] is in an outage (its link or its
+    host is down) until it is heard again; one silent for `lost_after` [s] is lost, and the team
+    does not wait for it once every other robot has ended. Times in seconds of the team's clock."""
+
+    def __init__(self, names: Sequence[str], silence: float = 5.0, lost_after: float = 60.0):
+        self.names = list(names)
+        self.silence, self.lost_after = silence, lost_after
+        self.heard = {}       # robot -> when last heard
+        self.outages: List[Outage] = []
+        self.open = {}        # robot -> its outage still going on
+
+    def hear(self, robot: str, now: float) -> Optional[Outage]:
+        """The robot said something at `now`; returns the outage it ends, if it was in one."""
+        if robot not in self.names:
+            return None
+        self.heard[robot] = now
+        ended = self.open.pop(robot, None)
+        if ended is not None:
+            ended.until = now
+        return ended
+
+    def check(self, now: float, ended: Sequence[str] = ()) -> List[Outage]:
+        """The outages that begin by `now` (robots heard before, silent since for more than
+        `silence`, and not `ended`: an explorer that has ended stops talking)."""
+        begun = []
+        for robot, last in self.heard.items():
+            if robot in ended or robot in self.open or now - last <= self.silence:
+                continue
+            outage = Outage(robot, last)
+            self.open[robot] = outage
+            self.outages.append(outage)
+            begun.append(outage)
+        return begun
+
+    def lost(self, now: float, ended: Sequence[str] = ()) -> List[str]:
+        """Robots not `ended` that have been silent for `lost_after` (heard once at least)."""
+        return [r for r, o in sorted(self.open.items()) if r not in ended and now - o.since >= self.lost_after]
+
+    def team_ends_without(self, now: float, ended: Sequence[str]) -> List[str]:
+        """The lost robots, when every other robot has ended (the team ends without them), else []."""
+        lost = self.lost(now, ended)
+        if lost and all(n in ended or n in lost for n in self.names):
+            return lost
+        return []

@@ -233,9 +233,15 @@ class Simulation:
         """Advances one step; returns the contacts that began in it."""
         new_contacts = []
         walked_into = self._step_people() if self.people else {}
+        several = len(self.robots) > 1
         for i, r in enumerate(self.robots.values()):
             v, w = r.drive.linear_velocity, r.drive.angular_velocity
             blocked = r.drive.step(self.step_size, self.time, self.geometry, i)
+            if several:
+                # The next robot checks its move against this one where it is now: two robots
+                # closing on each other in one step would otherwise both move into the same gap,
+                # overlap, and never part again (every move from an overlap overlaps).
+                self._update_dynamic()
             touching = blocked or r.name in walked_into
             if touching and not r.in_contact:
                 if r.name in walked_into:
