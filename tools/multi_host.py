@@ -9,7 +9,7 @@ down at the end, also on a failure or Ctrl-C.
         [--max-duration S] [--launch-arg name:=value ...] [--netem "delay 100ms loss 2%"] [--cut robot2:60:10]
         [--kill robot3:60]
 
---netem applies tc netem to every robot's link; --kill ROBOT:AT kills everything ROBOT's host runs
+--netem applies tc netem to every robot's link; --kill ROBOT:AT kills every process of ROBOT's host
 (SIGKILL) AT seconds (wall) after the robots start, as a host that dies; --cut ROBOT:AT:FOR takes ROBOT's link down AT
 seconds (wall) after the robots start, for FOR seconds. Prints the team's one line and the bytes
 each robot's link carried (both directions, TCPROS and the master's XML-RPC) per simulated and per
@@ -88,8 +88,20 @@ class Hosts:
                                    'and loss cannot be added here' % os.uname().release) from None
             raise
 
+    def kill_all(self, ns: str) -> int:
+        """SIGKILL to every process of namespace `ns` (as a host that dies: roslaunch starts each node
+        in a session of its own, so killing roslaunch's group leaves its nodes running); how many."""
+        pids = [int(p) for p in run('ip', 'netns', 'pids', ns, check=False).split()]
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        return len(pids)
+
     def remove(self) -> None:
         for ns in reversed(self.made):
+            self.kill_all(ns)  # nothing outlives its host: a namespace deleted leaves its processes running
             run('ip', 'netns', 'delete', ns, check=False)  # its links go with it
         self.made = []
 
@@ -139,10 +151,9 @@ def start(ns: str, ip: str, args: List[str], log: str) -> subprocess.Popen:
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
-def stop(procs: List[subprocess.Popen],
-         signals=((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0))) -> None:
+def stop(procs: List[subprocess.Popen]) -> None:
     """Ctrl-C to every roslaunch, then SIGTERM and SIGKILL to what is left of their groups."""
-    for sig, grace in signals:
+    for sig, grace in ((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, 5.0)):
         alive = [p for p in procs if p.poll() is None]
         if not alive:
             return
@@ -227,8 +238,8 @@ def main(argv=None) -> int:
         while not os.path.exists(report):
             now = time.monotonic() - t0
             if kill and now >= kill[1]:
-                stop([procs[1 + kill[0]]], signals=((signal.SIGKILL, 5.0),))
-                print('multi_host: robot%d host killed at %.0f s' % (kill[0] + 1, now), flush=True)
+                n = hosts.kill_all(hosts.robots[kill[0]])
+                print('multi_host: robot%d host killed at %.0f s (%d processes)' % (kill[0] + 1, now, n), flush=True)
                 killed = {'robot': 'robot%d' % (kill[0] + 1), 'at_wall_s': round(now, 1)}
                 kill = None
             if cut_state == 'pending' and now >= cut[1]:

@@ -11,7 +11,8 @@ while /clock stands still it waited for ever.
 
 cancel_goal cancels only a goal that has not finished: actionlib's cancels a finished one too, its
 goal handle leaves DONE, and the server's next status of it logs "Received comm state PREEMPTING
-when in simple state DONE" (red, at the end of every exploration).
+when in simple state DONE" (red, at the end of every exploration). Locks are taken in actionlib's
+order (the goal's, then this client's), so that a cancel during a status update cannot deadlock.
 
 With feedback=False the client does not subscribe to the server's feedback: move_base publishes
 it at controller_frequency (10 Hz in the tutorials) and a client that never reads it (the
@@ -63,8 +64,12 @@ class SimpleActionClient(actionlib.SimpleActionClient):
 
     def cancel_goal(self):
         with self._sending:
-            if self.gh and self.gh.get_comm_state() != CommState.DONE:
-                self.gh.cancel()
+            gh = self.gh
+        # Not under self._sending: the goal handle's cancel takes actionlib's lock of the goal and
+        # hands the new state to _handle_transition, which takes self._sending; actionlib's status
+        # thread takes the two in that order too, and holding ours here first deadlocked them.
+        if gh and gh.get_comm_state() != CommState.DONE:
+            gh.cancel()
 
     def _handle_transition(self, gh):
         with self._sending:
