@@ -18,8 +18,7 @@ SlamConfig readSlamConfig(const ParamValue& values, const std::string& ns, const
                                 "for map_merge on another host (its robot_map_updates_topic)");
   c.whole_map_period = r.number("whole_map_period", c.whole_map_period,
                                 "[s] ours: with publish_updates, the whole map at least this often, so that a subscriber "
-                                "that lost an update (its queue overflowed) is whole again; one that reconnects (a link "
-                                "back up) gets it at once",
+                                "that lost an update is whole again",
                                 std::nullopt, true);
   c.transform_publish_period = r.number("transform_publish_period", c.transform_publish_period,
                                         "[s] how often map -> odom is broadcast (0: only after each processed scan)", 0.0);
