@@ -9,12 +9,13 @@ down at the end, also on a failure or Ctrl-C.
         [--max-duration S] [--launch-arg name:=value ...] [--netem "delay 100ms loss 2%"] [--cut robot2:60:10]
         [--kill robot3:60]
 
---netem applies tc netem to every robot's link; --kill ROBOT:AT kills every process of ROBOT's host
-(SIGKILL) AT seconds (wall) after the robots start, as a host that dies; --cut ROBOT:AT:FOR takes ROBOT's link down AT
-seconds (wall) after the robots start, for FOR seconds. Prints the team's one line and the bytes
-each robot's link carried (both directions, TCPROS and the master's XML-RPC) per simulated and per
-wall second, and the message bytes of the robot's stack apart from the simulator's streams (which
-stay on board a real robot); adds them to the team's report.json (`link`). Exit status 0 only for outcome
+--netem applies tc netem to every robot's link; --kill ROBOT:AT kills every process of ROBOT's
+host (SIGKILL) AT seconds (wall) after the robots start, as a host that dies; --cut ROBOT:AT:FOR
+takes ROBOT's link down AT seconds (wall) after the robots start, for FOR seconds. Prints the team's
+one line and the bytes each robot's link carried (both directions, TCPROS and the master's XML-RPC)
+per simulated and per wall second, and the message bytes of the robot's stack apart from the
+simulator's streams (which stay on board a real robot); adds them to the team's report.json
+(`link`), with the outages the base station heard (`outages`). Exit status 0 only for outcome
 `complete`. Needs root (ip netns). `make demo ROBOTS=N HOSTS=separate` runs it.
 """
 import argparse
