@@ -87,7 +87,8 @@ class TeamWatch:
         """The outages that begin by `now` (robots heard before, silent since for more than
         `silence`, and not `ended`: an explorer that has ended stops talking)."""
         begun = []
-        for robot, last in self.heard.items():
+        # a copy: hear() runs in the subscriber's thread and may add a robot meanwhile
+        for robot, last in list(self.heard.items()):
             if robot in ended or robot in self.open or now - last <= self.silence:
                 continue
             outage = Outage(robot, last)
@@ -98,7 +99,7 @@ class TeamWatch:
 
     def lost(self, now: float, ended: Sequence[str] = ()) -> List[str]:
         """Robots not `ended` that have been silent for `lost_after` (heard once at least)."""
-        return [r for r, o in sorted(self.open.items()) if r not in ended and now - o.since >= self.lost_after]
+        return [r for r, o in sorted(list(self.open.items())) if r not in ended and now - o.since >= self.lost_after]
 
     def team_ends_without(self, now: float, ended: Sequence[str]) -> List[str]:
         """The lost robots, when every other robot has ended (the team ends without them), else []."""
