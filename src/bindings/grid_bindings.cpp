@@ -1,10 +1,12 @@
-// Bindings of the log-odds occupancy grid, Bresenham lines and grid ray casting.
+// Bindings of the log-odds occupancy grid, Bresenham lines, grid ray casting and the log of a
+// followed map's updates.
 #include "bindings.h"
 
 #include <tuple>
 
 #include "mbot_slam_navigation/core/bresenham.h"
 #include "mbot_slam_navigation/core/grid_raycast.h"
+#include "mbot_slam_navigation/core/map_updates.h"
 #include "mbot_slam_navigation/core/occupancy_grid.h"
 
 namespace mbot {
@@ -57,6 +59,30 @@ void bindGrid(py::module& m) {
         std::copy(data.begin(), data.end(), out.mutable_data());
         return out;
       });
+
+  py::class_<MapUpdateLog>(m, "_MapUpdateLog")
+      .def(py::init<>())
+      .def(
+          "update",
+          [](MapUpdateLog& log, int64_t stamp_ns, int x, int y, int width, int height,
+             const py::array_t<int8_t, py::array::c_style | py::array::forcecast>& data) {
+            return log.update(MapUpdate{stamp_ns, GridWindow{x, y, width, height},
+                                        std::vector<int8_t>(data.data(), data.data() + data.size())});
+          },
+          py::arg("stamp_ns"), py::arg("x"), py::arg("y"), py::arg("width"), py::arg("height"), py::arg("data"))
+      .def(
+          "whole",
+          [](MapUpdateLog& log, int64_t stamp_ns) {
+            py::list out;
+            for (const MapUpdate& u : log.whole(stamp_ns)) {
+              py::array_t<int8_t> data(static_cast<py::ssize_t>(u.data.size()));
+              std::copy(u.data.begin(), u.data.end(), data.mutable_data());
+              out.append(py::make_tuple(u.window.x, u.window.y, u.window.width, u.window.height, data));
+            }
+            return out;
+          },
+          py::arg("stamp_ns"))
+      .def_property_readonly("held", &MapUpdateLog::held);
 
   m.def(
       "_bresenham_line",

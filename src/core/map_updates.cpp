@@ -105,5 +105,27 @@ std::vector<GridWindow> changedWindows(const std::vector<int8_t>& before, const 
   return out;
 }
 
+bool MapUpdateLog::update(MapUpdate u) {
+  if (has_whole_ && u.stamp_ns <= whole_stamp_ns_) return false;
+  held_.push_back(std::move(u));
+  while (held_.size() > max_held_) held_.pop_front();
+  return has_whole_;
+}
+
+std::vector<MapUpdate> MapUpdateLog::whole(int64_t stamp_ns) {
+  if (has_whole_ && stamp_ns < whole_stamp_ns_) held_.clear();
+  has_whole_ = true;
+  whole_stamp_ns_ = stamp_ns;
+  std::vector<MapUpdate> newer;
+  std::deque<MapUpdate> kept;
+  for (auto& u : held_) {
+    if (u.stamp_ns <= stamp_ns) continue;
+    newer.push_back(u);
+    kept.push_back(std::move(u));
+  }
+  held_ = std::move(kept);
+  return newer;
+}
+
 }  // namespace core
 }  // namespace mbot

@@ -103,21 +103,25 @@ void CostmapROS::onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg) {
     std::lock_guard<std::mutex> guard(mutex_);
     layered_->setMap(msg->data, static_cast<int>(info.width), static_cast<int>(info.height),
                      {info.origin.position.x, info.origin.position.y}, info.resolution);
+    // updates that came before this map on the other connection, newer than it
+    for (const auto& u : map_log_.whole(msg->header.stamp.toNSec())) {
+      layered_->patchMap(u.data, u.window.x, u.window.y, u.window.width, u.window.height);
+    }
   }
   reportFilterErrors();
 }
 
 void CostmapROS::onMapUpdate(const map_msgs::OccupancyGridUpdate::ConstPtr& msg) {
-  bool applied;
-  {
-    std::lock_guard<std::mutex> guard(mutex_);
-    applied = layered_->patchMap(msg->data, msg->x, msg->y, static_cast<int>(msg->width), static_cast<int>(msg->height));
-  }
-  if (!applied) {
-    // costmap_2d's StaticLayer would write past its map; here the update waits for a whole map
-    ROS_WARN_THROTTLE(10, "%s: an update on %s (%u x %u cells at %d, %d) does not fit the map held; ignored until "
-                      "the next whole map", name_.c_str(), map_updates_sub_.getTopic().c_str(), msg->width, msg->height,
-                      msg->x, msg->y);
+  // Kept for the next whole map as well: it may be on its way on the other connection, older than
+  // this update, and must not write over it.
+  core::MapUpdate u{static_cast<int64_t>(msg->header.stamp.toNSec()),
+                    core::GridWindow{msg->x, msg->y, static_cast<int>(msg->width), static_cast<int>(msg->height)},
+                    msg->data};
+  std::lock_guard<std::mutex> guard(mutex_);
+  if (map_log_.update(u)) {
+    // One that does not fit (costmap_2d's StaticLayer would write past its map) waits for the
+    // whole map of the new size.
+    layered_->patchMap(u.data, u.window.x, u.window.y, u.window.width, u.window.height);
   }
 }
 

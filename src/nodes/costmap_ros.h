@@ -29,6 +29,7 @@
 #include <tf2_ros/buffer.h>
 
 #include "mbot_slam_navigation/core/layered_costmap.h"
+#include "mbot_slam_navigation/core/map_updates.h"
 
 namespace mbot {
 namespace ros_glue {
@@ -76,6 +77,7 @@ class CostmapROS {
   std::function<void(const ros::Time&)> beat_;
   std::unique_ptr<core::LayeredCostmap> layered_;
   mutable std::mutex mutex_;
+  core::MapUpdateLog map_log_;  // the static layer's map updates newer than its whole map (mutex_)
   std::string tf_problem_;
   // Set and read from several callback threads.
   std::atomic<bool> ever_updated_{false}, active_{true}, send_full_{true};

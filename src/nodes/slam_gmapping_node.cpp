@@ -481,10 +481,11 @@ class SlamGmappingNode {
   static int blockCells(double resolution) { return std::max(1, static_cast<int>(std::lround(4.0 / resolution))); }
 
   /// With ~publish_updates: whether `map` goes whole (its size or origin changed,
-  /// ~whole_map_period passed, or the clock went back); map_mutex_ held.
+  /// ~whole_map_period passed, or the clock has not moved on since the last whole map: its
+  /// subscribers take an update stamped so for part of that map); map_mutex_ held.
   bool sendsWhole(const nav_msgs::OccupancyGrid& map, const ros::Time& stamp) {
     const auto& a = map.info;
-    if (!last_map_ || whole_sent_at_.isZero() || stamp < whole_sent_at_ ||
+    if (!last_map_ || whole_sent_at_.isZero() || stamp <= whole_sent_at_ ||
         (stamp - whole_sent_at_).toSec() >= whole_map_period_) {
       return true;
     }

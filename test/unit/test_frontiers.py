@@ -654,13 +654,29 @@ def test_a_keepout_zone_makes_no_frontier_and_counts_what_it_took():
     assert stats['keepout_m'] == 0.0
 
 
-def test_map_updates_patch_a_copy_and_refuse_what_does_not_fit():
+def test_a_followed_map_patches_a_copy_and_keeps_what_does_not_fit_for_the_next_whole_map():
     from types import SimpleNamespace
-    from mbot_slam_navigation.nav.explore import patched_grid
-    m = room()
-    update = SimpleNamespace(x=10, y=20, width=3, height=2, data=[100] * 6)
-    p = patched_grid(m, update)
-    assert (p.data[20:22, 10:13] == 100).all() and m.data[20, 10] != 100  # the old grid is untouched
+    import rospy
+    from mbot_slam_navigation.maps.updates import FollowedMap
+
+    def whole(grid, t):
+        return SimpleNamespace(data=grid.data.ravel(), header=SimpleNamespace(stamp=rospy.Time(t)), info=SimpleNamespace(
+            width=grid.data.shape[1], height=grid.data.shape[0], resolution=grid.resolution,
+            origin=SimpleNamespace(position=SimpleNamespace(x=grid.origin[0], y=grid.origin[1]))))
+
+    def update(x, y, w, h, value, t):
+        return SimpleNamespace(x=x, y=y, width=w, height=h, data=[value] * (w * h),
+                               header=SimpleNamespace(stamp=rospy.Time(t)))
+
+    m, f = room(), FollowedMap()
+    assert f.update(update(10, 20, 3, 2, 100, 1)) is None  # no whole map yet
+    held = f.whole(whole(m, 2))
+    assert (held.data == m.data).all()  # the update older than the map is not applied again
+    p = f.update(update(10, 20, 3, 2, 100, 3))
+    assert (p.data[20:22, 10:13] == 100).all() and held.data[20, 10] != 100  # the old grid is untouched
     assert p.origin == m.origin and p.resolution == m.resolution
-    assert patched_grid(m, SimpleNamespace(x=159, y=0, width=3, height=1, data=[0] * 3)) is None
-    assert patched_grid(None, update) is None
+    # the map grows: its update overtakes it, does not fit the map held, and is written into it when it comes
+    assert f.update(update(159, 0, 3, 1, 100, 5)) is None
+    grown = Grid(np.pad(m.data, ((0, 0), (0, 10)), constant_values=-1), m.resolution, m.origin)
+    g = f.whole(whole(grown, 4))
+    assert g.data.shape == grown.data.shape and (g.data[0, 159:162] == 100).all()

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -98,4 +99,93 @@ TEST(MapUpdates, PaddedToBlocksKeepsTheCellsWhereTheyAreAndItsSizeWhileTheyStayI
   EXPECT_EQ(kept.width, sent.width);
   EXPECT_EQ(kept.height, sent.height);
   EXPECT_EQ(paddedToBlocks(m, 8).width, 8);
+}
+
+namespace {
+// A subscriber's copy of a map: whole maps replace it, updates that fit are written into it.
+struct HeldMap {
+  int width = 0, height = 0;
+  std::vector<int8_t> data;
+  void apply(const mbot::core::MapUpdate& u) {
+    const GridWindow& w = u.window;
+    if (w.x < 0 || w.y < 0 || w.x + w.width > width || w.y + w.height > height) return;
+    for (int r = 0; r < w.height; ++r)
+      std::copy_n(u.data.begin() + static_cast<long>(r) * w.width, w.width, data.begin() + (w.y + r) * width + w.x);
+  }
+};
+}  // namespace
+
+// A publisher's map grows and changes; whole maps and updates travel on two connections, each in
+// order, but interleaved at random. With the log the subscriber ends with the publisher's map
+// whatever the interleaving; applying each message as it comes loses updates.
+TEST(MapUpdateLog, EveryInterleavingOfWholeMapsAndUpdatesEndsWithThePublishersMap) {
+  using mbot::core::MapUpdate;
+  using mbot::core::MapUpdateLog;
+  struct Whole {
+    int64_t stamp;
+    HeldMap map;
+  };
+  int naive_wrong = 0;
+  for (int seed = 0; seed < 200; ++seed) {
+    std::mt19937 rng(seed);
+    std::vector<Whole> wholes;
+    std::vector<MapUpdate> updates;
+    HeldMap pub{32, 32, std::vector<int8_t>(32 * 32, -1)};
+    for (int k = 0; k < 40; ++k) {
+      const HeldMap before = pub;
+      if (k % 9 == 4) {  // grown by a block to the right and up: the old cells stay where they were
+        HeldMap grown{pub.width + 16, pub.height + 16, std::vector<int8_t>((pub.width + 16) * (pub.height + 16), -1)};
+        for (int r = 0; r < pub.height; ++r)
+          std::copy_n(pub.data.begin() + r * pub.width, pub.width, grown.data.begin() + r * grown.width);
+        pub = grown;
+      }
+      for (int i = 0; i < 30; ++i) pub.data[rng() % pub.data.size()] = static_cast<int8_t>(rng() % 2 ? 0 : 100);
+      const int64_t stamp = 1000 + k;
+      if (k == 0 || before.width != pub.width || k % 7 == 0) {
+        wholes.push_back({stamp, pub});
+      } else {
+        for (const auto& w : changedWindows(before.data, pub.data, pub.width, pub.height, 16)) {
+          MapUpdate u{stamp, w, {}};
+          for (int r = w.y; r < w.y + w.height; ++r)
+            u.data.insert(u.data.end(), pub.data.begin() + r * pub.width + w.x, pub.data.begin() + r * pub.width + w.x + w.width);
+          updates.push_back(u);
+        }
+      }
+    }
+    MapUpdateLog log;
+    HeldMap sub, naive;
+    std::size_t wi = 0, ui = 0;
+    while (wi < wholes.size() || ui < updates.size()) {
+      const bool take_whole = ui == updates.size() || (wi < wholes.size() && rng() % 4 == 0);
+      if (take_whole) {
+        sub = naive = wholes[wi].map;
+        for (const auto& u : log.whole(wholes[wi].stamp)) sub.apply(u);
+        ++wi;
+      } else {
+        if (log.update(updates[ui])) sub.apply(updates[ui]);
+        naive.apply(updates[ui]);
+        ++ui;
+      }
+    }
+    ASSERT_EQ(sub.width, pub.width) << "seed " << seed;
+    ASSERT_EQ(sub.data, pub.data) << "seed " << seed;
+    EXPECT_LT(log.held(), updates.size());
+    naive_wrong += naive.data != pub.data;
+  }
+  EXPECT_GT(naive_wrong, 100);  // the hazard the log is for is real in this test
+}
+
+// A whole map older than the one held (the clock went back) starts a new log; updates not newer
+// than the whole map held are not applied again.
+TEST(MapUpdateLog, AClockThatWentBackStartsANewLog) {
+  mbot::core::MapUpdateLog log;
+  mbot::core::MapUpdate u{5, GridWindow{0, 0, 1, 1}, {100}};
+  EXPECT_FALSE(log.update(u));  // no whole map yet: kept
+  EXPECT_EQ(log.whole(3).size(), 1u);
+  u.stamp_ns = 3;
+  EXPECT_FALSE(log.update(u));  // the whole map has it
+  u.stamp_ns = 9;
+  EXPECT_TRUE(log.update(u));
+  EXPECT_TRUE(log.whole(2).empty());  // reset: what came before it is forgotten
+  EXPECT_EQ(log.held(), 0u);
 }

@@ -3,7 +3,9 @@
 // blocks, so that its size changes seldom, and the windows over the cells that changed.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "mbot_slam_navigation/core/slam_grid.h"
@@ -35,6 +37,50 @@ GridWindow frameCells(const OccupancyImage& image);
 /// Throws std::invalid_argument for sizes that do not match or tile < 1.
 std::vector<GridWindow> changedWindows(const std::vector<int8_t>& before, const std::vector<int8_t>& after, int width,
                                        int height, int tile);
+
+/// A window of a map and its new cells (row-major), stamped with the time of the map it belongs
+/// to [ns]: a map_msgs/OccupancyGridUpdate.
+struct MapUpdate {
+  int64_t stamp_ns = 0;
+  GridWindow window;
+  std::vector<int8_t> data;
+};
+
+/// The subscriber's side of a map received whole and as updates on two topics, as slam_gmapping
+/// and map_merge send it with publish_updates (and costmap_2d its costmap and costmap_updates).
+/// Two topics are two connections: an update can arrive before the whole map that was sent before
+/// it, and be lost under it, or not fit the map held because that whole map changed the size.
+/// The log keeps every update newer than the whole map held, so that each whole map that arrives
+/// gets the updates newer than it applied again, and updates that came first are not lost. An
+/// update is newer than a whole map when its stamp is later: a publisher stamps each map (whole, or
+/// its updates) with the time it was made, and a whole map holds every change made up to its stamp.
+class MapUpdateLog {
+ public:
+  /// At most this many updates are kept (the oldest are dropped first): a publisher sends a whole
+  /// map every minute or so, which empties the log.
+  explicit MapUpdateLog(std::size_t max_held = 20000) : max_held_(max_held) {}
+
+  /// An update arrived. Returns whether to apply it to the map held now: false before the first
+  /// whole map and for an update not newer than the whole map held (that map has it already).
+  /// Every update newer than the whole map held is kept for the next whole map.
+  bool update(MapUpdate u);
+
+  /// A whole map stamped `stamp_ns` arrived: returns the updates to apply to it, in the order they
+  /// came (those newer than it). The older ones are forgotten. A whole map older than the one held
+  /// (the clock went back: a simulation reset) starts a new log.
+  std::vector<MapUpdate> whole(int64_t stamp_ns);
+
+  /// Whether a whole map has arrived.
+  bool hasWhole() const { return has_whole_; }
+  /// The updates kept.
+  std::size_t held() const { return held_.size(); }
+
+ private:
+  std::size_t max_held_;
+  bool has_whole_ = false;
+  int64_t whole_stamp_ns_ = 0;
+  std::deque<MapUpdate> held_;
+};
 
 }  // namespace core
 }  // namespace mbot

@@ -63,6 +63,7 @@ from mbot_slam_navigation.batched_reads import clock_at_most_every
 from mbot_slam_navigation.home_rooms import load_rooms, rooms_file_of
 from mbot_slam_navigation.host_check import address_problem
 from mbot_slam_navigation.lazy_tf import LazyTransformBuffer
+from mbot_slam_navigation.maps.updates import FollowedMap, grid_of
 from mbot_slam_navigation.msg import Contact, ExplorerState
 from mbot_slam_navigation.nav.action_client import SimpleActionClient
 from mbot_slam_navigation.nav.escape import backtrack_target, escape_command
@@ -100,23 +101,6 @@ def sim_sleep(seconds: float, poll: float = 0.02) -> None:
         if now >= end or now < start:
             return
         time.sleep(poll)
-
-
-def grid_of(msg: OccupancyGrid) -> Grid:
-    return Grid(np.asarray(msg.data, np.int8).reshape(msg.info.height, msg.info.width), msg.info.resolution,
-                (msg.info.origin.position.x, msg.info.origin.position.y))
-
-
-def patched_grid(m: Optional[Grid], msg) -> Optional[Grid]:
-    """`m` with the window of a map_msgs/OccupancyGridUpdate replaced (a new Grid: readers may hold
-    the old one), or None when the update does not fit it (before the first whole map, or one of
-    another size: wait for the next whole map)."""
-    x, y, w, h = msg.x, msg.y, msg.width, msg.height
-    if m is None or x + w > m.data.shape[1] or y + h > m.data.shape[0] or len(msg.data) != w * h:
-        return None
-    data = m.data.copy()
-    data[y:y + h, x:x + w] = np.asarray(msg.data, np.int8).reshape(h, w)
-    return Grid(data, m.resolution, m.origin)
 
 
 def read_parameters(r: ParamReader, default_robot_name: str = 'robot') -> SimpleNamespace:
@@ -294,6 +278,7 @@ class Explore:
         # Started by the same roslaunch as SLAM and move_base: a connection rospy lost while both
         # registered is made again during the start-up wait (topic_watch).
         self.map_lock = threading.Lock()  # the whole map's and the updates' callbacks run in two threads
+        self.followed = FollowedMap()
         if c.subscribe_to_updates:
             rospy.Subscriber(map_topic + '_updates', numpy_msg(OccupancyGridUpdate), self.on_map_update, queue_size=100)
         self.inputs = [WatchedSubscriber(map_topic, numpy_msg(OccupancyGrid), self.on_map, queue_size=1,
@@ -412,8 +397,8 @@ class Explore:
         self.team_pub.publish(msg)
 
     def on_map(self, msg: OccupancyGrid) -> None:
-        with self.map_lock:  # not interleaved with an update's read-modify-write
-            self.map = grid_of(msg)
+        with self.map_lock:  # the held map replaced in the order the followed map takes them
+            self.map = self.followed.whole(msg)
             self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
@@ -421,13 +406,11 @@ class Explore:
     def on_map_update(self, msg: OccupancyGridUpdate) -> None:
         """A window of the map replaced (a new Grid: the explorer's loop may hold the old one)."""
         with self.map_lock:
-            m = patched_grid(self.map, msg)
+            m = self.followed.update(msg)
             if m is not None:
                 self.map = m
                 self.map_with_stamp = (self.map, msg.header.stamp)
-        if m is None:
-            rospy.logwarn_throttle(10, 'explore: an update on %s_updates does not fit the map held; ignored until the '
-                                   'next whole map' % rospy.resolve_name(self.map_topic))
+        if m is None:  # not for the map held: kept for the next whole map
             return
         if self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
