@@ -72,16 +72,18 @@ void bindGrid(py::module& m) {
           py::arg("stamp_ns"), py::arg("x"), py::arg("y"), py::arg("width"), py::arg("height"), py::arg("data"))
       .def(
           "whole",
-          [](MapUpdateLog& log, int64_t stamp_ns) {
+          [](MapUpdateLog& log, int64_t stamp_ns, int64_t now_ns) -> py::object {
+            const auto newer = log.whole(stamp_ns, now_ns);
+            if (!newer) return py::none();
             py::list out;
-            for (const MapUpdate& u : log.whole(stamp_ns)) {
+            for (const MapUpdate& u : *newer) {
               py::array_t<int8_t> data(static_cast<py::ssize_t>(u.data.size()));
               std::copy(u.data.begin(), u.data.end(), data.mutable_data());
               out.append(py::make_tuple(u.window.x, u.window.y, u.window.width, u.window.height, data));
             }
-            return out;
+            return std::move(out);
           },
-          py::arg("stamp_ns"))
+          py::arg("stamp_ns"), py::arg("now_ns"))
       .def_property_readonly("held", &MapUpdateLog::held);
 
   m.def(

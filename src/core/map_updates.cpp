@@ -112,8 +112,11 @@ bool MapUpdateLog::update(MapUpdate u) {
   return has_whole_;
 }
 
-std::vector<MapUpdate> MapUpdateLog::whole(int64_t stamp_ns) {
-  if (has_whole_ && stamp_ns < whole_stamp_ns_) held_.clear();
+std::optional<std::vector<MapUpdate>> MapUpdateLog::whole(int64_t stamp_ns, int64_t now_ns) {
+  if (has_whole_ && stamp_ns < whole_stamp_ns_) {
+    if (now_ns >= whole_stamp_ns_) return std::nullopt;
+    held_.clear();
+  }
   has_whole_ = true;
   whole_stamp_ns_ = stamp_ns;
   std::vector<MapUpdate> newer;

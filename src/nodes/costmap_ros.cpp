@@ -101,12 +101,13 @@ void CostmapROS::onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg) {
   }
   {
     std::lock_guard<std::mutex> guard(mutex_);
+    // updates that came before this map on the other connection, newer than it
+    const auto newer = map_log_.whole(static_cast<int64_t>(msg->header.stamp.toNSec()),
+                                      static_cast<int64_t>(ros::Time::now().toNSec()));
+    if (!newer) return;  // stale: a latched map older than the one held
     layered_->setMap(msg->data, static_cast<int>(info.width), static_cast<int>(info.height),
                      {info.origin.position.x, info.origin.position.y}, info.resolution);
-    // updates that came before this map on the other connection, newer than it
-    for (const auto& u : map_log_.whole(msg->header.stamp.toNSec())) {
-      layered_->patchMap(u.data, u.window.x, u.window.y, u.window.width, u.window.height);
-    }
+    for (const auto& u : *newer) layered_->patchMap(u.data, u.window.x, u.window.y, u.window.width, u.window.height);
   }
   reportFilterErrors();
 }

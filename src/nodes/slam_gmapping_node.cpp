@@ -731,7 +731,7 @@ class SlamGmappingNode {
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_, updates_pub_;
   bool publish_updates_ = false;
-  double whole_map_period_ = 60.0;  // [s]
+  double whole_map_period_ = 300.0;  // [s]
   ros::Time whole_sent_at_;             // when `map` was last published whole (map_mutex_)
   mbot::core::GridWindow covered_;      // the frame's cells the last map covered (publish_updates)
   static constexpr int kUpdateTile = 16;  // [cells] the tiles of map_updates' windows

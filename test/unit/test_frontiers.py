@@ -670,7 +670,7 @@ def test_a_followed_map_patches_a_copy_and_keeps_what_does_not_fit_for_the_next_
 
     m, f = room(), FollowedMap()
     assert f.update(update(10, 20, 3, 2, 100, 1)) is None  # no whole map yet
-    held = f.whole(whole(m, 2))
+    held = f.whole(whole(m, 2), rospy.Time(2))
     assert (held.data == m.data).all()  # the update older than the map is not applied again
     p = f.update(update(10, 20, 3, 2, 100, 3))
     assert (p.data[20:22, 10:13] == 100).all() and held.data[20, 10] != 100  # the old grid is untouched
@@ -678,5 +678,7 @@ def test_a_followed_map_patches_a_copy_and_keeps_what_does_not_fit_for_the_next_
     # the map grows: its update overtakes it, does not fit the map held, and is written into it when it comes
     assert f.update(update(159, 0, 3, 1, 100, 5)) is None
     grown = Grid(np.pad(m.data, ((0, 0), (0, 10)), constant_values=-1), m.resolution, m.origin)
-    g = f.whole(whole(grown, 4))
+    g = f.whole(whole(grown, 4), rospy.Time(5))
     assert g.data.shape == grown.data.shape and (g.data[0, 159:162] == 100).all()
+    # a stale latched map (older than the one held, the clock not gone back) leaves it as it is
+    assert f.whole(whole(m, 1), rospy.Time(6)) is g and f.stamp == rospy.Time(4)

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "mbot_slam_navigation/core/slam_grid.h"
@@ -65,10 +66,12 @@ class MapUpdateLog {
   /// Every update newer than the whole map held is kept for the next whole map.
   bool update(MapUpdate u);
 
-  /// A whole map stamped `stamp_ns` arrived: returns the updates to apply to it, in the order they
-  /// came (those newer than it). The older ones are forgotten. A whole map older than the one held
-  /// (the clock went back: a simulation reset) starts a new log.
-  std::vector<MapUpdate> whole(int64_t stamp_ns);
+  /// A whole map stamped `stamp_ns` arrived at `now_ns`: returns the updates to apply to it, in the
+  /// order they came (those newer than it), and forgets the older ones. A whole map older than the
+  /// one held is either stale (a latched map that a publisher sent a new subscriber after a newer
+  /// one, as rospy and, by a narrow race, roscpp can): nullopt, not to be taken; or, when the clock
+  /// is now behind the map held (a simulation reset), the start of a new log.
+  std::optional<std::vector<MapUpdate>> whole(int64_t stamp_ns, int64_t now_ns);
 
   /// Whether a whole map has arrived.
   bool hasWhole() const { return has_whole_; }

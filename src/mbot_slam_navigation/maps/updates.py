@@ -44,12 +44,15 @@ class FollowedMap:
         self.grid: Optional[Grid] = None
         self.stamp = None
 
-    def whole(self, msg) -> Grid:
-        """A whole map (nav_msgs/OccupancyGrid) arrived: held, with the updates newer than it."""
+    def whole(self, msg, now) -> Grid:
+        """A whole map (nav_msgs/OccupancyGrid) arrived at `now` (rospy.Time): held, with the updates
+        newer than it; the map held stays when this one is stale (older than it, and the clock has
+        not gone back)."""
         grid = grid_of(msg)
         with self._lock:
-            self.grid = _patched(grid, self._log.whole(msg.header.stamp.to_nsec()))
-            self.stamp = msg.header.stamp
+            newer = self._log.whole(msg.header.stamp.to_nsec(), now.to_nsec())
+            if newer is not None:
+                self.grid, self.stamp = _patched(grid, newer), msg.header.stamp
             return self.grid
 
     def update(self, msg) -> Optional[Grid]:

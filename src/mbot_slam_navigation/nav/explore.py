@@ -398,9 +398,10 @@ class Explore:
 
     def on_map(self, msg: OccupancyGrid) -> None:
         with self.map_lock:  # the held map replaced in the order the followed map takes them
-            self.map = self.followed.whole(msg)
-            self.map_with_stamp = (self.map, msg.header.stamp)  # one assignment: read together
-        if self.start_time is not None:
+            self.map = self.followed.whole(msg, rospy.Time.now())
+            taken = self.followed.stamp == msg.header.stamp  # else a stale latched map
+            self.map_with_stamp = (self.map, self.followed.stamp)  # one assignment: read together
+        if taken and self.start_time is not None:
             self.curve.append(((msg.header.stamp - self.start_time).to_sec(), explore_report.known_area(self.map)))
 
     def on_map_update(self, msg: OccupancyGridUpdate) -> None:
