@@ -489,9 +489,12 @@ class SlamGmappingNode {
         (stamp - whole_sent_at_).toSec() >= whole_map_period_) {
       return true;
     }
+    // Origins compared to a thousandth of a cell: the same block's origin comes out of the map's
+    // own (floating) origin a few 1e-15 m apart from one map to the next.
     const auto& b = last_map_->info;
-    return a.width != b.width || a.height != b.height || a.resolution != b.resolution ||
-           a.origin.position.x != b.origin.position.x || a.origin.position.y != b.origin.position.y;
+    const double tol = 1e-3 * b.resolution;
+    return a.width != b.width || a.height != b.height || std::abs(a.resolution - b.resolution) > 1e-9 ||
+           std::abs(a.origin.position.x - b.origin.position.x) > tol || std::abs(a.origin.position.y - b.origin.position.y) > tol;
   }
 
   /// What changed since the last map, as map_msgs/OccupancyGridUpdate windows on map_updates (the
@@ -731,7 +734,7 @@ class SlamGmappingNode {
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Publisher map_pub_, meta_pub_, entropy_pub_, heartbeat_pub_, correction_pub_, weakest_pub_, updates_pub_;
   bool publish_updates_ = false;
-  double whole_map_period_ = 300.0;  // [s]
+  double whole_map_period_ = 60.0;  // [s]
   ros::Time whole_sent_at_;             // when `map` was last published whole (map_mutex_)
   mbot::core::GridWindow covered_;      // the frame's cells the last map covered (publish_updates)
   static constexpr int kUpdateTile = 16;  // [cells] the tiles of map_updates' windows

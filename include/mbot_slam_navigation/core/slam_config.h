@@ -22,7 +22,7 @@ struct SlamConfig {
   /// its size grows (by 4 m blocks), a subscriber comes, or every whole_map_period: for subscribers
   /// on other hosts (map_merge's robot_map_updates_topic).
   bool publish_updates = false;
-  double whole_map_period = 300.0;         ///< [s] with publish_updates, the whole map at least this often
+  double whole_map_period = 60.0;          ///< [s] with publish_updates, the whole map at least this often
   double transform_publish_period = 0.05;  ///< [s] between map -> odom broadcasts; 0: none
   double occ_thresh = 0.25;                ///< occupancy above which a cell is published occupied
   double tf_delay = -1.0;                  ///< [s] gmapping's; < 0: transform_publish_period
