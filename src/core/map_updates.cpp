@@ -106,23 +106,30 @@ std::vector<GridWindow> changedWindows(const std::vector<int8_t>& before, const 
 }
 
 bool MapUpdateLog::update(MapUpdate u) {
+  if (u.stamp_ns == 0) return has_whole_;
   if (has_whole_ && u.stamp_ns <= whole_stamp_ns_) return false;
+  held_bytes_ += u.data.size();
   held_.push_back(std::move(u));
-  while (held_.size() > max_held_) held_.pop_front();
+  while (!held_.empty() && (held_.size() > max_held_ || held_bytes_ > max_bytes_)) {
+    held_bytes_ -= held_.front().data.size();
+    held_.pop_front();
+  }
   return has_whole_;
 }
 
 std::optional<std::vector<MapUpdate>> MapUpdateLog::whole(int64_t stamp_ns, int64_t now_ns) {
   if (has_whole_ && stamp_ns < whole_stamp_ns_) {
-    if (now_ns >= whole_stamp_ns_) return std::nullopt;
+    if (stamp_ns != 0 && now_ns >= whole_stamp_ns_) return std::nullopt;
     held_.clear();
   }
   has_whole_ = true;
   whole_stamp_ns_ = stamp_ns;
   std::vector<MapUpdate> newer;
   std::deque<MapUpdate> kept;
+  held_bytes_ = 0;
   for (auto& u : held_) {
     if (u.stamp_ns <= stamp_ns) continue;
+    held_bytes_ += u.data.size();
     newer.push_back(u);
     kept.push_back(std::move(u));
   }

@@ -192,3 +192,16 @@ TEST(MapUpdateLog, AnOlderWholeMapIsStaleUnlessTheClockWentBack) {
   EXPECT_TRUE(log.whole(2, 2)->empty());  // reset: what came before it is forgotten
   EXPECT_EQ(log.held(), 0u);
 }
+
+// Updates without a stamp are applied and not kept; a whole map without one is always taken; the
+// log keeps at most its bytes, the oldest updates dropped first.
+TEST(MapUpdateLog, UnstampedMessagesAreAppliedAndTheLogIsBounded) {
+  mbot::core::MapUpdateLog log(100, 1000);
+  EXPECT_TRUE(log.whole(50, 50).has_value());
+  EXPECT_TRUE(log.update({0, GridWindow{0, 0, 1, 1}, {100}}));
+  EXPECT_EQ(log.held(), 0u);
+  EXPECT_TRUE(log.whole(0, 60).has_value());  // unstamped: taken though older than the one held
+  for (int k = 1; k <= 30; ++k) log.update({k, GridWindow{0, 0, 10, 10}, std::vector<int8_t>(100, 0)});
+  EXPECT_EQ(log.held(), 10u);  // 1000 bytes: the 10 newest
+  EXPECT_EQ(log.whole(25, 30)->size(), 5u);
+}

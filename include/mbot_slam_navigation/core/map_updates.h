@@ -57,20 +57,25 @@ struct MapUpdate {
 /// its updates) with the time it was made, and a whole map holds every change made up to its stamp.
 class MapUpdateLog {
  public:
-  /// At most this many updates are kept (the oldest are dropped first): a publisher sends a whole
-  /// map every minute or so, which empties the log.
-  explicit MapUpdateLog(std::size_t max_held = 20000) : max_held_(max_held) {}
+  /// At most `max_held` updates and `max_bytes` of their cells are kept (the oldest are dropped
+  /// first): our publishers send a whole map every minute or so, which empties the log, but one
+  /// that never does (costmap_2d sends its costmap whole only to new subscribers) must not fill
+  /// the memory.
+  explicit MapUpdateLog(std::size_t max_held = 20000, std::size_t max_bytes = 32u << 20)
+      : max_held_(max_held), max_bytes_(max_bytes) {}
 
   /// An update arrived. Returns whether to apply it to the map held now: false before the first
   /// whole map and for an update not newer than the whole map held (that map has it already).
-  /// Every update newer than the whole map held is kept for the next whole map.
+  /// Every update newer than the whole map held is kept for the next whole map. An update without
+  /// a stamp (0) cannot be ordered: it is applied to the map held and not kept.
   bool update(MapUpdate u);
 
   /// A whole map stamped `stamp_ns` arrived at `now_ns`: returns the updates to apply to it, in the
   /// order they came (those newer than it), and forgets the older ones. A whole map older than the
   /// one held is either stale (a latched map that a publisher sent a new subscriber after a newer
   /// one, as rospy and, by a narrow race, roscpp can): nullopt, not to be taken; or, when the clock
-  /// is now behind the map held (a simulation reset), the start of a new log.
+  /// is now behind the map held (a simulation reset), the start of a new log. A whole map without a
+  /// stamp (0) is always taken, and starts a new log.
   std::optional<std::vector<MapUpdate>> whole(int64_t stamp_ns, int64_t now_ns);
 
   /// Whether a whole map has arrived.
@@ -79,7 +84,7 @@ class MapUpdateLog {
   std::size_t held() const { return held_.size(); }
 
  private:
-  std::size_t max_held_;
+  std::size_t max_held_, max_bytes_, held_bytes_ = 0;
   bool has_whole_ = false;
   int64_t whole_stamp_ns_ = 0;
   std::deque<MapUpdate> held_;
