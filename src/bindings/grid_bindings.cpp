@@ -83,8 +83,7 @@ void bindGrid(py::module& m) {
             }
             return std::move(out);
           },
-          py::arg("stamp_ns"), py::arg("now_ns"))
-      .def_property_readonly("held", &MapUpdateLog::held);
+          py::arg("stamp_ns"), py::arg("now_ns"));
 
   m.def(
       "_bresenham_line",

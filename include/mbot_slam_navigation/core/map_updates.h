@@ -78,8 +78,6 @@ class MapUpdateLog {
   /// stamp (0) is always taken, and starts a new log.
   std::optional<std::vector<MapUpdate>> whole(int64_t stamp_ns, int64_t now_ns);
 
-  /// Whether a whole map has arrived.
-  bool hasWhole() const { return has_whole_; }
   /// The updates kept.
   std::size_t held() const { return held_.size(); }
 

@@ -99,7 +99,7 @@ class TeamWatch:
 
     def lost(self, now: float, ended: Sequence[str] = ()) -> List[str]:
         """Robots not `ended` that have been silent for `lost_after` (heard once at least)."""
-        return [r for r, o in sorted(list(self.open.items())) if r not in ended and now - o.since >= self.lost_after]
+        return [r for r, o in sorted(self.open.items()) if r not in ended and now - o.since >= self.lost_after]
 
     def team_ends_without(self, now: float, ended: Sequence[str]) -> List[str]:
         """The lost robots, when every other robot has ended (the team ends without them), else []."""
