@@ -56,7 +56,42 @@ void validateFootprint(const Footprint& f) {
   if (!inside) throw std::invalid_argument("footprint does not contain the robot's centre (0, 0)");
 }
 
+bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector4d& box) {
+  double t0 = 0.0, t1 = 1.0;
+  const double d[2] = {b.x() - a.x(), b.y() - a.y()};
+  const double lo[2] = {box[0] - a.x(), box[1] - a.y()}, hi[2] = {box[2] - a.x(), box[3] - a.y()};
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(d[k]) < 1e-12) {
+      if (lo[k] > 0.0 || hi[k] < 0.0) return false;
+      continue;
+    }
+    double ta = lo[k] / d[k], tb = hi[k] / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 namespace {
+/// Even-odd test of point q against the polygon `corners[0..n)`.
+bool insidePolygon(const Eigen::Vector2d* corners, std::size_t n, const Eigen::Vector2d& q) {
+  bool inside = false;
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Eigen::Vector2d &a = corners[i], &b = corners[j];
+    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
+  }
+  return inside;
+}
+
+/// A lethal cell's box in the grid's cell units, grown by cell_box::kMargin plus `extra` [m].
+Eigen::Vector4d boxInCells(const Costmap& map, const Cell& c, double extra) {
+  const Eigen::Vector4d b = map.obstacleBounds(c, cell_box::kMargin + extra);
+  const double res = map.resolution(), ox = map.origin().x(), oy = map.origin().y();
+  return {(b[0] - ox) / res, (b[1] - oy) / res, (b[2] - ox) / res, (b[3] - oy) / res};
+}
+
 /// The radius of a footprint whose vertices all lie on one circle about the centre and that has at
 /// least 8 of them (robot_radius's 16-gon, padded or scaled), else 0.
 double roundRadius(const Footprint& footprint) {
@@ -71,7 +106,7 @@ double roundRadius(const Footprint& footprint) {
 /// footprintCost of a round robot: every cell the circle of `radius` about (x, y) passes through,
 /// so that turning on the spot never changes the answer (the 16-gon's outline cells do change as
 /// it turns: a robot at its goal could not turn to the goal's yaw beside a wall corner).
-int ringCost(const Costmap& map, double x, double y, double radius, bool unknown_is_obstacle) {
+int ringCost(const Costmap& map, double x, double y, double radius, bool unknown_is_obstacle, double box_margin) {
   const double res = map.resolution();
   const double cx = (x - map.origin().x()) / res, cy = (y - map.origin().y()) / res, r = radius / res, r2 = r * r;
   const int x_lo = static_cast<int>(std::floor(cx - r)), x_hi = static_cast<int>(std::floor(cx + r));
@@ -99,6 +134,14 @@ int ringCost(const Costmap& map, double x, double y, double radius, bool unknown
         continue;
       }
       const uint8_t v = row[i];
+      if (v == cost::kLethal && map.box(static_cast<std::size_t>(j) * w + i) != cell_box::kNoBox) {
+        // The obstacle's box, not the whole cell: touched when nearer to the centre than r.
+        const Eigen::Vector4d b = boxInCells(map, {i, j}, box_margin);
+        const double dx = std::max({b[0] - cx, 0.0, cx - b[2]}), dy = std::max({b[1] - cy, 0.0, cy - b[3]});
+        if (dx * dx + dy * dy < r2) return -1;
+        worst = std::max(worst, static_cast<int>(cost::kInscribed));
+        continue;
+      }
       if (v == cost::kLethal || (v == cost::kNoInformation && unknown_is_obstacle)) return -1;
       if (v != cost::kNoInformation) worst = std::max(worst, static_cast<int>(v));
     }
@@ -107,14 +150,25 @@ int ringCost(const Costmap& map, double x, double y, double radius, bool unknown
 }
 }  // namespace
 
+bool footprintMeetsRect(const Eigen::Vector3d& pose, const Footprint& footprint, const Eigen::Vector4d& rect) {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  std::vector<Eigen::Vector2d> corners;
+  for (const auto& v : footprint) corners.emplace_back(pose.x() + c * v.x() - s * v.y(), pose.y() + s * v.x() + c * v.y());
+  for (std::size_t i = 0, j = corners.size() - 1; i < corners.size(); j = i++) {
+    if (segmentMeetsRect(corners[j], corners[i], rect)) return true;
+  }
+  return insidePolygon(corners.data(), corners.size(), {0.5 * (rect[0] + rect[2]), 0.5 * (rect[1] + rect[3])});
+}
+
 double contactRadius(const Footprint& footprint) {
   const double round = roundRadius(footprint);
   return round > 0.0 ? round : inscribedRadius(footprint);
 }
 
-int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle) {
+int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint, bool unknown_is_obstacle,
+                  double box_margin) {
   const double round = roundRadius(footprint);
-  if (round > 0.0) return ringCost(map, pose.x(), pose.y(), round, unknown_is_obstacle);
+  if (round > 0.0) return ringCost(map, pose.x(), pose.y(), round, unknown_is_obstacle, box_margin);
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
   // The local planner calls this for every step of every trajectory: corners in a stack array when
   // they fit (no allocation, no thread-local lookup). Corners in cell units; cells by flooring, as
@@ -144,18 +198,32 @@ int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footpri
   const int w = map.width();
   int worst = 0;
   bool blocked = false;
+  const bool boxes = map.hasBoxes();
   // Every cell the outline passes through (walkSegment), not Bresenham's cells between the corner
   // cells: those let a wall corner 2 cm inside the outline go unseen (the mbot wedged itself so
   // against the home's kitchen door jamb).
   for (std::size_t i = 0, j = n - 1; i < n && !blocked; j = i++) {
-    // Each edge starts where the last one ended: that corner cell is visited once, by the first.
+    // Each edge starts where the last one ended: that corner cell is visited once, by the first
+    // (but for a box, which each edge must be checked against).
     bool first = j != n - 1;
     walkSegment(corners[j].x(), corners[j].y(), corners[i].x(), corners[i].y(), [&](const Cell& cell) {
+      const std::size_t k = static_cast<std::size_t>(cell.y) * w + cell.x;
+      const uint8_t v = costs[k];
       if (first) {
         first = false;
+        if (!(v == cost::kLethal && boxes && map.box(k) != cell_box::kNoBox)) return true;
+      }
+      if (v == cost::kLethal && boxes && map.box(k) != cell_box::kNoBox) {
+        // The obstacle's box, not the whole cell: touched when this edge or the inside meets it.
+        const Eigen::Vector4d b = boxInCells(map, cell, box_margin);
+        if (segmentMeetsRect(corners[j], corners[i], b) ||
+            insidePolygon(corners, n, {0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])})) {
+          blocked = true;
+          return false;
+        }
+        worst = std::max(worst, static_cast<int>(cost::kInscribed));
         return true;
       }
-      const uint8_t v = costs[static_cast<std::size_t>(cell.y) * w + cell.x];
       if (v == cost::kLethal || (v == cost::kNoInformation && unknown_is_obstacle)) {
         blocked = true;
         return false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -22,16 +23,24 @@ uint8_t inflatedCost(double d, const InflationParams& p) {
   return static_cast<uint8_t>((cost::kInscribed - 1) * std::exp(-p.cost_scaling_factor * (d - p.inscribed_radius)));
 }
 
-uint8_t contactCost(const InflationParams& p, double resolution, double contact_radius) {
+namespace {
+/// [m] The largest cell-centre distance of a whole cell that can touch a footprint of contact_radius.
+double farthestContact(double resolution, double contact_radius) {
   const double reach = contact_radius / resolution;  // [cells]
-  double farthest = 0.0;                             // [cells] centre distance of the farthest touching cell
+  double farthest = 0.0;                             // [cells]
   for (int dx = 0; dx <= static_cast<int>(reach) + 1; ++dx) {
     for (int dy = 0; dy <= dx; ++dy) {
       const double gap = std::hypot(std::max(dx - 0.5, 0.0), std::max(dy - 0.5, 0.0));  // to the cell's square
       if (gap < reach) farthest = std::max(farthest, std::hypot(dx, dy));
     }
   }
-  const uint8_t c = inflatedCost(farthest * resolution, p);
+  return farthest * resolution;
+}
+}  // namespace
+
+uint8_t contactCost(const InflationParams& p, double resolution, double contact_radius, double clearance) {
+  if (clearance > 0.0) return inflatedCost(farthestContact(resolution, contact_radius) + clearance, p);
+  const uint8_t c = inflatedCost(farthestContact(resolution, contact_radius), p);
   return c == cost::kFree || c > cost::kInscribed ? cost::kInscribed : c;
 }
 
@@ -212,6 +221,92 @@ void inflateWindow(const Costmap& base, Costmap& out, const CellWindow& window, 
     std::copy(base.costs().begin() + i + win.x0, base.costs().begin() + i + win.x1, out.costs().begin() + i + win.x0);
   }
   inflateInto(base, out, win, params);
+}
+
+void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window, const InflationParams& params,
+                     double contact_radius) {
+  const CellWindow win = window.grown(0, base.width(), base.height());
+  if (win.empty() || !base.hasBoxes()) return;
+  const int w = base.width();
+  for (int y = win.y0; y < win.y1; ++y) {
+    for (int x = win.x0; x < win.x1; ++x) out.setBox(static_cast<std::size_t>(y) * w + x, base.box(static_cast<std::size_t>(y) * w + x));
+  }
+  const double res = base.resolution();
+  const double farthest = farthestContact(res, contact_radius);
+  const double offset = farthest - contact_radius;  // [m] added to a distance to an obstacle's outline
+  // Cells whose nearest whole-cell distance is at most `band` are refined: beyond it a box moves
+  // the cost by less than the costs can matter to a footprint check or a plan through a gap.
+  const double band = farthest + 1.5 * res;
+  const int reach = static_cast<int>(std::ceil(band / res)) + 1;  // [cells] searched around a cell
+  const uint8_t band_cost = inflatedCost(band, params);
+  const uint8_t* in = base.costs().data();
+  uint8_t* o = out.costs().data();
+  // The lethal cells within reach of the window, row by row in x order, as world rectangles [m].
+  struct Obstacle {
+    int x;
+    bool boxed;
+    Eigen::Vector4d rect;
+  };
+  const CellWindow read = win.grown(reach, base.width(), base.height());
+  std::vector<std::vector<Obstacle>> rows(static_cast<std::size_t>(read.y1 - read.y0));
+  for (int y = read.y0; y < read.y1; ++y) {
+    const uint8_t* row = in + static_cast<std::size_t>(y) * w;
+    for (int x = read.x0; x < read.x1; ++x) {
+      if (row[x] != cost::kLethal) continue;
+      const bool boxed = base.box(static_cast<std::size_t>(y) * w + x) != cell_box::kNoBox;
+      rows[y - read.y0].push_back({x, boxed, base.obstacleBounds({x, y}, boxed ? cell_box::kMargin : 0.0)});
+    }
+  }
+  auto squaredDistance = [](const Eigen::Vector4d& b, const Eigen::Vector2d& at) {
+    const double dx = std::max({b[0] - at.x(), 0.0, at.x() - b[2]}), dy = std::max({b[1] - at.y(), 0.0, at.y() - b[3]});
+    return dx * dx + dy * dy;
+  };
+  const double spread = res / 3.0 * std::sqrt(2.0);  // [m] from a cell's centre to its farthest sample point
+  std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (centre distance [m], rectangle)
+  for (int y = win.y0; y < win.y1; ++y) {
+    for (int x = win.x0; x < win.x1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const uint8_t now = o[i];
+      if (now == cost::kLethal || now < band_cost || now == cost::kNoInformation || now == cost::kFree) continue;
+      const Eigen::Vector2d centre = base.cellCenter({x, y});
+      near.clear();
+      bool boxed = false;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int cy = std::max(read.y0, y - reach); cy <= std::min(read.y1 - 1, y + reach); ++cy) {
+        const std::vector<Obstacle>& row = rows[cy - read.y0];
+        auto it = std::lower_bound(row.begin(), row.end(), x - reach, [](const Obstacle& a, int v) { return a.x < v; });
+        for (; it != row.end() && it->x <= x + reach; ++it) {
+          const double d = std::sqrt(squaredDistance(it->rect, centre));
+          boxed = boxed || it->boxed;
+          nearest = std::min(nearest, d);
+          near.emplace_back(d, &it->rect);
+        }
+      }
+      if (!boxed) continue;  // only whole cells near: inflateWindow's cost stands
+      // The clearance of the best of 3 x 3 points in the cell: a plan through a gap that is open
+      // only within a centimetre or two of its middle must not depend on where the cell centres
+      // fall (the local planner's footprint check is made at the robot's true pose). Only the
+      // obstacles that can be nearest to one of the points are measured from each.
+      const double keep = nearest + 2.0 * spread;
+      double best = 0.0;
+      for (int sy = -1; sy <= 1; ++sy) {
+        for (int sx = -1; sx <= 1; ++sx) {
+          const Eigen::Vector2d at = centre + Eigen::Vector2d(sx, sy) * (res / 3.0);
+          double d2 = std::numeric_limits<double>::infinity();
+          for (const auto& [d, rect] : near) {
+            if (d <= keep) d2 = std::min(d2, squaredDistance(*rect, at));
+          }
+          best = std::max(best, d2);
+        }
+      }
+      const uint8_t c = inflatedCost(std::max(std::sqrt(best) + offset, 1e-6), params);
+      if (in[i] == cost::kNoInformation) {
+        o[i] = (params.inflate_unknown ? c > cost::kFree : c >= cost::kInscribed) ? c : in[i];
+      } else {
+        o[i] = std::max(in[i], c);
+      }
+    }
+  }
 }
 
 }  // namespace core

@@ -488,7 +488,17 @@ void LayeredCostmap::resize(int width, int height, const Eigen::Vector2d& origin
   obstacle_ = Costmap(width, height, resolution, origin, config_.obstacle_layer ? obstacle_default_ : cost::kFree);
   base_ = Costmap(width, height, resolution, origin, default_value_);
   master_ = Costmap(width, height, resolution, origin, default_value_);
+  enableBoxes();
   full_ = true;
+}
+
+void LayeredCostmap::enableBoxes() {
+  // Only the obstacle layer knows where in a cell its obstacle is; the boxes go with its lethal
+  // cells into base_ and master_, where the footprint checks and the inflation near them read them.
+  if (!config_.obstacle_layer) return;
+  obstacle_.enableBoxes();
+  base_.enableBoxes();
+  master_.enableBoxes();
 }
 
 int LayeredCostmap::sourceIndex(const std::string& name) const {
@@ -555,7 +565,9 @@ void LayeredCostmap::setMap(const std::vector<int8_t>& data, int width, int heig
         if (ny < 0 || ny >= height) continue;
         for (int x = 0; x < old.width(); ++x) {
           const int nx = x + dx;
-          if (nx >= 0 && nx < width) obstacle_.setCost({nx, ny}, old.cost({x, y}));
+          if (nx < 0 || nx >= width) continue;
+          obstacle_.setCost({nx, ny}, old.cost({x, y}));
+          obstacle_.setBox(obstacle_.index({nx, ny}), old.box(old.index({x, y})));
         }
       }
     }
@@ -660,9 +672,18 @@ void LayeredCostmap::compose(const CellWindow& w) {
       const uint8_t* o = obstacle_.costs().data() + row;
       const bool overwrite = config_.obstacle_layer->combination_method == 0;
       for (int x = w.x0; x < w.x1; ++x) {
-        if (o[x] == cost::kNoInformation) continue;
-        if (overwrite || b[x] == cost::kNoInformation || o[x] > b[x]) b[x] = o[x];  // updateWithMax
+        if (o[x] == cost::kNoInformation) {
+          base_.setBox(row + x, cell_box::kNoBox);
+          continue;
+        }
+        // updateWithMax; a lethal cell takes the obstacle layer's box only when no other layer
+        // has it lethal (a map's lethal cell is whole).
+        const bool box = o[x] == cost::kLethal && (overwrite || b[x] != cost::kLethal);
+        if (overwrite || b[x] == cost::kNoInformation || o[x] > b[x]) b[x] = o[x];
+        base_.setBox(row + x, box ? obstacle_.box(row + x) : cell_box::kNoBox);
       }
+    } else if (base_.hasBoxes()) {
+      for (int x = w.x0; x < w.x1; ++x) base_.setBox(row + x, cell_box::kNoBox);
     }
   }
   applyKeepout(w);
@@ -689,7 +710,10 @@ void LayeredCostmap::applyKeepout(const CellWindow& w) {
         const int x0 = std::max(begin - dx, w.x0), x1 = std::min(end - dx, w.x1);
         for (int x = x0; x < x1; ++x) {
           const uint8_t c = keepoutCost(m[x + dx]);
-          if (b[x] == cost::kNoInformation || c > b[x]) b[x] = c;  // Nav2's KeepoutFilter rule
+          if (b[x] == cost::kNoInformation || c > b[x]) {
+            b[x] = c;  // Nav2's KeepoutFilter rule
+            base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
+          }
         }
       }
     }
@@ -757,6 +781,7 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
     if ((obstacle_.origin() - before).norm() > 1e-12) {
       base_ = Costmap(obstacle_.width(), obstacle_.height(), obstacle_.resolution(), obstacle_.origin(), default_value_);
       master_ = Costmap(obstacle_.width(), obstacle_.height(), obstacle_.resolution(), obstacle_.origin(), default_value_);
+      enableBoxes();
       full_ = true;
     }
   }
@@ -783,11 +808,22 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
     }
     if (ob->footprint_clearing_enabled) {
       for (const Cell& cell : footprintCells(obstacle_, robot_pose, config_.footprint)) {
-        if (obstacle_.contains(cell)) obstacle_.setCost(cell, cost::kFree);
+        if (!obstacle_.contains(cell)) continue;
+        // A return outside the footprint is not the robot's own body, though its cell is under the
+        // outline: beside a post in a gap its mark must stay for the footprint checks.
+        const uint32_t box = obstacle_.box(obstacle_.index(cell));
+        if (box != cell_box::kNoBox && obstacle_.cost(cell) == cost::kLethal &&
+            !footprintMeetsRect(robot_pose, config_.footprint, obstacle_.obstacleBounds(cell, 0.0))) {
+          continue;
+        }
+        obstacle_.setCost(cell, cost::kFree);
       }
       // What covers the laser is not the robot's own body seen by its sensor, which is what
       // footprint clearing is for: a person who walked into the robot stays marked where it is.
-      for (const Cell& cell : too_close) obstacle_.setCost(cell, cost::kLethal);
+      for (const Cell& cell : too_close) {
+        obstacle_.setCost(cell, cost::kLethal);
+        obstacle_.setBox(obstacle_.index(cell), cell_box::kNoBox);
+      }
       dirty_ = dirty_.unite(cellsAround(robot_pose.head<2>(), config_.circumscribed_radius + obstacle_.resolution()));
     }
   }
@@ -808,17 +844,27 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
     window = window.grown(reach, w, h);  // cells whose inflation the change may alter
     if (inflating) {
       inflateWindow(base_, master_, window, inflation_);
+      if (base_.hasBoxes()) {
+        refineNearBoxes(base_, master_, window, inflation_, contactRadius(config_.footprint));
+      }
     } else {
       for (int y = window.y0; y < window.y1; ++y) {
         const std::size_t row = static_cast<std::size_t>(y) * w;
         std::copy(base_.costs().begin() + row + window.x0, base_.costs().begin() + row + window.x1,
                   master_.costs().begin() + row + window.x0);
+        for (int x = window.x0; x < window.x1; ++x) master_.setBox(row + x, base_.box(row + x));
       }
     }
   }
   dirty_ = CellWindow{};
   full_ = false;
   return window;
+}
+
+uint8_t LayeredCostmap::roomyCost() const {
+  if (!config_.inflation_layer || !config_.inflation_layer->enabled) return contactCost();
+  const uint8_t c = core::contactCost(inflation_, master_.resolution(), contactRadius(config_.footprint), kRoomyClearance);
+  return c > cost::kFree ? std::min(c, contactCost()) : contactCost();
 }
 
 uint8_t LayeredCostmap::contactCost() const {
@@ -837,7 +883,10 @@ void LayeredCostmap::resetObstacles(const std::optional<Eigen::Vector3d>& keep) 
     const int x1 = static_cast<int>(std::ceil((keep->x() + half - obstacle_.origin().x()) / res));
     const int y1 = static_cast<int>(std::ceil((keep->y() + half - obstacle_.origin().y()) / res));
     for (int y = std::max(y0, 0); y < std::min(y1, obstacle_.height()); ++y) {
-      for (int x = std::max(x0, 0); x < std::min(x1, obstacle_.width()); ++x) obstacle_.setCost({x, y}, old.cost({x, y}));
+      for (int x = std::max(x0, 0); x < std::min(x1, obstacle_.width()); ++x) {
+        obstacle_.setCost({x, y}, old.cost({x, y}));
+        obstacle_.setBox(obstacle_.index({x, y}), old.box(old.index({x, y})));
+      }
     }
   }
   full_ = true;

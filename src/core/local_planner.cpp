@@ -235,7 +235,7 @@ void LocalPlanner::buildNonZeroTable(const Costmap& map) {
   }
 }
 
-int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer) const {
+int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer, double box_margin) const {
   if (table_valid_) {
     // Every outline cell lies in the cells of the circumscribed circle's bounding square.
     const Cell lo = map.worldToCell({pose.x() - circumscribed_, pose.y() - circumscribed_});
@@ -262,7 +262,7 @@ int LocalPlanner::footprintCostAt(const Costmap& map, const Eigen::Vector3d& pos
       }
     }
   }
-  return footprintCost(map, pose, footprint_, /*unknown_is_obstacle=*/true);
+  return footprintCost(map, pose, footprint_, /*unknown_is_obstacle=*/true, box_margin);
 }
 
 void LocalPlanner::setPlan(const std::vector<Eigen::Vector2d>& plan) {
@@ -390,6 +390,7 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   // Steps whose footprint is known valid but whose outline cost was not computed (see exact_below).
   bool deferred = false;
   const bool may_defer = table_valid_ && exact_below < std::numeric_limits<double>::infinity();
+  const double box_margin = map.hasBoxes() ? box_latency_ * (vmag + std::abs(vth_samp) * circumscribed_) : 0.0;
   for (int i = 0; i < steps; ++i) {
     const Cell cell = map.worldToCell({x, y});
     if (!map.contains(cell)) return;  // off the local map
@@ -397,7 +398,7 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
     if (i > 0 && min_lethal_distance_ < std::numeric_limits<double>::infinity() &&
         nearestLethal(map, {x, y}, min_lethal_distance_) < min_lethal_distance_ - 1e-3)
       return;  // nearer to what stands inside the footprint (escaping)
-    const int fp = footprintCostAt(map, {x, y, th}, may_defer ? &deferred : nullptr);
+    const int fp = footprintCostAt(map, {x, y, th}, may_defer ? &deferred : nullptr, box_margin);
     if (fp < 0) return;
     occ = std::max({occ, static_cast<double>(fp), static_cast<double>(map.cost(cell))});
     if (p.simple_attractor) {
@@ -432,7 +433,7 @@ void LocalPlanner::generate(const Costmap& map, const Eigen::Vector3d& pose, con
   traj.cost_exact = !deferred;
   if (deferred && traj.cost <= exact_below) {
     // It may win: the outline costs of every step, exactly.
-    for (const Eigen::Vector3d& q : traj.points) occ = std::max(occ, static_cast<double>(footprintCost(map, q, footprint_, true)));
+    for (const Eigen::Vector3d& q : traj.points) occ = std::max(occ, static_cast<double>(footprintCost(map, q, footprint_, true, box_margin)));
     traj.cost = rest + occ_scale_ * occ;
     traj.cost_exact = true;
   }
@@ -473,7 +474,11 @@ Footprint LocalPlanner::useEscapeFootprint(const Costmap& map, const Eigen::Vect
     if (map.contains(here)) max_centre_cost_ = map.cost(here);
   }
   if (footprintCost(map, pose, footprint_, true) < 0) {
-    for (double scale : kEscapeScales) {
+    // Boxes (cell_box) are where the laser saw the surface, with a centimetre to spare: a footprint
+    // that touches one is shrunk by as little as frees it, or its corners swing into the next one.
+    std::vector<double> scales(std::begin(kEscapeScales), std::end(kEscapeScales));
+    if (map.hasBoxes()) scales.insert(scales.begin(), std::begin(kBoxEscapeScales), std::end(kBoxEscapeScales));
+    for (double scale : scales) {
       Footprint shrunk(full.size());
       for (std::size_t i = 0; i < full.size(); ++i) shrunk[i] = scale * full[i];
       if (footprintCost(map, pose, shrunk, true) >= 0) {
@@ -507,8 +512,14 @@ double LocalPlanner::nearestLethal(const Costmap& map, const Eigen::Vector2d& at
     for (int dx = -reach; dx <= reach; ++dx) {
       const Cell c{c0.x + dx, c0.y + dy};
       if (!map.contains(c) || map.cost(c) != cost::kLethal) continue;
-      const Eigen::Vector2d off = (map.cellCenter(c) - at).cwiseAbs().array() - half;
-      const double d = off.cwiseMax(0.0).norm();
+      double d;
+      if (map.box(map.index(c)) != cell_box::kNoBox) {
+        const Eigen::Vector4d b = map.obstacleBounds(c, cell_box::kMargin);
+        d = std::hypot(std::max({b[0] - at.x(), 0.0, at.x() - b[2]}), std::max({b[1] - at.y(), 0.0, at.y() - b[3]}));
+      } else {
+        const Eigen::Vector2d off = (map.cellCenter(c) - at).cwiseAbs().array() - half;
+        d = off.cwiseMax(0.0).norm();
+      }
       if (d <= within && d < best) best = d;
     }
   }
@@ -536,6 +547,14 @@ Trajectory LocalPlanner::findBestPath(const Costmap& map, const Eigen::Vector3d&
   inside_distance_ = min_lethal_distance_ < inscribedRadius(full) ? min_lethal_distance_
                                                                    : std::numeric_limits<double>::infinity();
   Trajectory best = createTrajectories(map, pose, velocity);
+  if (best.cost < 0 && map.hasBoxes()) {
+    // The latency margin is a reason to drive slowly near boxes, not to stand still: where no
+    // move keeps it (a robot already a centimetre or two from a box all round), moves are taken
+    // without it, as with whole cells.
+    box_latency_ = 0.0;
+    best = createTrajectories(map, pose, velocity);
+    box_latency_ = kBoxLatency;
+  }
   restoreFootprint(full);
   table_valid_ = false;
   if (best.cost < 0) best.xv = best.yv = best.thetav = 0.0;

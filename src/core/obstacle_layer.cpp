@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "mbot_slam_navigation/core/bresenham.h"
+#include "mbot_slam_navigation/core/footprint.h"
 
 namespace mbot {
 namespace core {
@@ -19,7 +21,12 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
   params.validate();
   const Eigen::Vector2d origin = sensor_pose.head<2>();
   const Cell from = layer.worldToCell(origin);
-  std::vector<Cell> marks;
+  struct Mark {
+    Cell cell;
+    Eigen::Vector2d at;  // [cells] the return in the grid's cell units; NaN: the whole cell
+  };
+  std::vector<Mark> marks;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     double r = scan.ranges_m[i];
     bool is_return = true;
@@ -30,7 +37,7 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
       const double a = sensor_pose.z() + scan.beamAngle(i);
       const Cell end = layer.worldToCell(origin + scan.range_min_m * Eigen::Vector2d(std::cos(a), std::sin(a)));
       if (layer.contains(end)) {
-        marks.push_back(end);
+        marks.push_back({end, {nan, nan}});
         if (too_close) too_close->push_back(end);
       }
       continue;
@@ -48,16 +55,37 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
       const double clear_r = std::min(r, params.raytrace_range);
       const Cell clear_end = layer.worldToCell(origin + clear_r * dir);
       // Clear up to the end point's cell, never the end point itself (it is what the beam hit).
+      // A lethal cell with a box stays unless the beam passed through the box: a beam that grazes
+      // a post's edge cell and returns from behind it has not seen the post go (whole cells lose
+      // such edges, and a gap between two posts looks open again from farther away).
+      const Eigen::Vector2d beam_end = origin + clear_r * dir;
       walkLine(from, clear_end, [&](const Cell& c) {
         if (!layer.contains(c)) return false;
         if (is_return && c == end) return false;
+        if (layer.cost(c) == cost::kLethal && layer.box(layer.index(c)) != cell_box::kNoBox &&
+            !segmentMeetsRect(origin, beam_end, layer.obstacleBounds(c, 0.0))) {
+          return true;
+        }
         layer.setCost(c, cost::kFree);
         return true;
       });
     }
-    if (params.marking && is_return && r < params.obstacle_range && layer.contains(end)) marks.push_back(end);
+    if (params.marking && is_return && r < params.obstacle_range && layer.contains(end)) {
+      marks.push_back({end, (origin + r * dir - layer.origin()) / layer.resolution()});
+    }
   }
-  for (const Cell& c : marks) layer.setCost(c, cost::kLethal);  // after clearing, as costmap_2d
+  // After clearing, as costmap_2d. A cell lethal before (and not cleared since) grows its box.
+  for (const Mark& m : marks) {
+    const std::size_t i = layer.index(m.cell);
+    const bool fresh = layer.cost(m.cell) != cost::kLethal;
+    layer.setCost(m.cell, cost::kLethal);
+    if (std::isnan(m.at.x())) {
+      layer.setBox(i, cell_box::kNoBox);
+    } else {
+      const double fx = m.at.x() - m.cell.x, fy = m.at.y() - m.cell.y;
+      layer.setBox(i, fresh ? cell_box::ofPoint(fx, fy) : cell_box::grow(layer.box(i), fx, fy));
+    }
+  }
   return static_cast<int>(marks.size());
 }
 

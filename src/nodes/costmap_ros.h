@@ -63,6 +63,8 @@ class CostmapROS {
   const core::Costmap& master() const { return layered_->master(); }
   /// LayeredCostmap::contactCost, for the map's current resolution (valid while the lock is held).
   uint8_t contactCost() const { return layered_->contactCost(); }
+  /// LayeredCostmap::roomyCost, likewise.
+  uint8_t roomyCost() const { return layered_->roomyCost(); }
 
  private:
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);

@@ -308,3 +308,135 @@ TEST(ObstacleLayer, MinusInfinityMarksRangeMinAndDriverErrorCodesDoNothing) {
   p.too_close_is_obstacle = false;
   EXPECT_EQ(updateWithScan(ros_way, {0, 0, 0}, fan({-inf, -inf, -inf, -inf}), p), 0);
 }
+
+namespace {
+/// A scan from `at` (x, y, yaw) of discs (x, y, radius), 720 beams over 360 degrees, exact ranges.
+LaserScan scanOfDiscs(const Eigen::Vector3d& at, const std::vector<Eigen::Vector3d>& discs) {
+  LaserScan s;
+  s.angle_min_rad = -M_PI;
+  s.angle_increment_rad = 2 * M_PI / 720;
+  s.range_min_m = 0.1;
+  s.range_max_m = 6.0;
+  for (int i = 0; i < 720; ++i) {
+    const double a = at.z() + s.angle_min_rad + i * s.angle_increment_rad;
+    const Eigen::Vector2d d(std::cos(a), std::sin(a));
+    float r = std::numeric_limits<float>::infinity();
+    for (const auto& c : discs) {
+      const Eigen::Vector2d o = at.head<2>() - c.head<2>();
+      const double b = o.dot(d), q = o.squaredNorm() - c.z() * c.z(), disc = b * b - q;
+      if (disc >= 0 && -b - std::sqrt(disc) > 0) r = std::min(r, static_cast<float>(-b - std::sqrt(disc)));
+    }
+    s.ranges_m.push_back(r);
+  }
+  return s;
+}
+}  // namespace
+
+TEST(CellBoxes, AMarkKeepsTheBoxOfItsReturnsAndAMapCellStaysWhole) {
+  Costmap layer(40, 40, 0.05, {0, 0});
+  layer.enableBoxes();
+  ObservationSourceParams p;
+  // One disc seen from two sides: its cells' boxes hold what each side saw, inside the cell.
+  const std::vector<Eigen::Vector3d> disc = {{1.0, 1.0, 0.1}};
+  updateWithScan(layer, {0.4, 1.0, 0.0}, scanOfDiscs({0.4, 1.0, 0.0}, disc), p);
+  updateWithScan(layer, {1.6, 1.0, M_PI}, scanOfDiscs({1.6, 1.0, M_PI}, disc), p);
+  int marked = 0;
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      if (layer.cost({x, y}) != cost::kLethal) continue;
+      ++marked;
+      const uint32_t b = layer.box(layer.index({x, y}));
+      ASSERT_NE(b, cell_box::kNoBox);
+      // Every corner of the box lies within 1 cm (the margin) of the disc's circle or inside it.
+      const Eigen::Vector4d r = layer.obstacleBounds({x, y}, 0.0);
+      const Eigen::Vector2d centre(1.0, 1.0);
+      const double nearest = std::hypot(std::max({r[0] - 1.0, 0.0, 1.0 - r[2]}), std::max({r[1] - 1.0, 0.0, 1.0 - r[3]}));
+      EXPECT_LE(nearest, 0.1 + 1e-3) << "box of cell " << x << ", " << y << " lies off the disc";
+      EXPECT_LT(r[2] - r[0], 0.05) << "a box as wide as its cell at " << x << ", " << y;
+    }
+  }
+  EXPECT_GT(marked, 6);
+  // The whole grid filled again: no box outlives its mark.
+  layer.fill(cost::kLethal);
+  EXPECT_EQ(layer.box(layer.index({20, 20})), cell_box::kNoBox);
+}
+
+TEST(CellBoxes, AGapJustWiderThanTheRobotIsOpenToTheLaserAndShutToWholeCells) {
+  // Two posts (radius 0.1 m) whose surfaces are 0.46 m apart (1.15x the mbot's 0.4 m), seen from
+  // before the gap, and the padded mbot (0.42 m) in the gap's middle facing through it. Whole
+  // 0.05 m cells round the gap to 0.36-0.46 m: with the posts' surfaces near the middle of their
+  // cells it is shut, to the footprint check and to the planner's contact cost. With the boxes of
+  // the returns it is open to both; a gap the robot does not fit (0.40 m) stays shut.
+  const Footprint fp = padFootprint({{-0.2, -0.2}, {-0.2, 0.2}, {0.2, 0.2}, {0.2, -0.2}}, 0.01);
+  InflationParams ip;
+  ip.inscribed_radius = inscribedRadius(fp);
+  ip.inflation_radius = 0.6;
+  ip.cost_scaling_factor = 10.0;
+  const double contact_radius = contactRadius(fp);
+  const uint8_t contact = contactCost(ip, 0.05, contact_radius);
+  for (double gap : {0.46, 0.40}) {
+    // Centred on a cell's edge at y = 1.5 m, so each surface lies mid-cell (1.5 -/+ gap / 2).
+    const double y = 1.5, r = 0.1;
+    const std::vector<Eigen::Vector3d> posts = {{1.5, y - gap / 2 - r, r}, {1.5, y + gap / 2 + r, r}};
+    for (bool boxes : {false, true}) {
+      Costmap layer(60, 60, 0.05, {0, 0});
+      if (boxes) layer.enableBoxes();
+      ObservationSourceParams p;
+      for (double x0 : {0.5, 0.8, 1.0}) updateWithScan(layer, {x0, y, 0.0}, scanOfDiscs({x0, y, 0.0}, posts), p);
+      Costmap master = layer;
+      inflateWindow(layer, master, {0, 0, 60, 60}, ip);
+      refineNearBoxes(layer, master, {0, 0, 60, 60}, ip, contact_radius);
+      const Cell mid = master.worldToCell({1.5, y + 0.01});
+      const bool planner_open = master.cost(mid) < contact || master.cost(master.worldToCell({1.5, y - 0.01})) < contact;
+      const bool footprint_open = footprintCost(master, {1.5, y, 0.0}, fp) >= 0;
+      SCOPED_TRACE("gap " + std::to_string(gap) + (boxes ? " with boxes" : " whole cells"));
+      EXPECT_EQ(footprint_open, boxes && gap > 0.44);
+      EXPECT_EQ(planner_open, boxes && gap > 0.44);
+    }
+  }
+}
+
+TEST(CellBoxes, AFootprintInACellBelowTheContactCostFitsWithoutTouchingABox) {
+  // The rule of Inflation.AFootprintCentredBelowTheContactCostNeverTouchesALethalCell, for cells
+  // whose obstacles are boxes of random size and place, among whole cells: below the contact cost
+  // the footprint fits somewhere in the cell (refineNearBoxes takes the best of 3 x 3 points).
+  const Footprint fp = padFootprint(circleFootprint(0.2), 0.01);
+  InflationParams p;
+  p.inscribed_radius = inscribedRadius(fp);
+  p.inflation_radius = 0.6;
+  p.cost_scaling_factor = 10.0;
+  const uint8_t contact = contactCost(p, 0.05, contactRadius(fp));
+  int open_cells = 0;  // cells below the contact cost that whole cells would have put above it
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    std::srand(seed);
+    Costmap base(80, 80, 0.05, {0, 0});
+    base.enableBoxes();
+    for (int k = 0; k < 40; ++k) {
+      const Cell c{10 + std::rand() % 60, 10 + std::rand() % 60};
+      base.setCost(c, cost::kLethal);
+      if (k % 4 == 0) continue;  // a whole cell
+      const int x0 = std::rand() % 200, y0 = std::rand() % 200;
+      base.setBox(base.index(c), cell_box::pack(x0, y0, x0 + 1 + std::rand() % (254 - x0), y0 + 1 + std::rand() % (254 - y0)));
+    }
+    Costmap whole = base, master = base;
+    inflate(whole, p);
+    inflateWindow(base, master, {0, 0, 80, 80}, p);
+    refineNearBoxes(base, master, {0, 0, 80, 80}, p, contactRadius(fp));
+    for (int y = 10; y < 70; ++y) {
+      for (int x = 10; x < 70; ++x) {
+        const uint8_t c = master.cost({x, y});
+        const Eigen::Vector2d centre = master.cellCenter({x, y});
+        if (c < contact) {
+          bool clear = false;  // somewhere in the cell: one of its 3 x 3 points
+          for (int k = 0; k < 9 && !clear; ++k) {
+            const Eigen::Vector2d at = centre + Eigen::Vector2d(k % 3 - 1, k / 3 - 1) * (0.05 / 3.0);
+            clear = footprintCost(master, {at.x(), at.y(), 0.0}, fp) >= 0;
+          }
+          ASSERT_TRUE(clear) << "cost " << int(c) << " below the contact cost " << int(contact) << " at " << x << ", " << y;
+          open_cells += whole.cost({x, y}) >= contact;
+        }
+      }
+    }
+  }
+  EXPECT_GT(open_cells, 0) << "the boxes opened nothing: the test shows nothing";
+}

@@ -458,3 +458,33 @@ TEST(LocalPlanner, FacingThePlanWithNoRoomAheadItBacksUpInsteadOfTurning) {
   EXPECT_EQ(turn.xv, 0.0);
   EXPECT_LT(turn.thetav, 0.0);
 }
+
+TEST(LocalPlanner, ThroughAGapItClearsByCentimetresItDrivesSlowly) {
+  // Two rows of posts whose faces the laser saw 0.45 m apart (boxes in their cells), the mbot's
+  // 0.4 m square inside the gap facing through it: 2.5 cm a side, 1.5 cm past the boxes' margin.
+  // At 0.3 m/s a command acts 3 cm late (kBoxLatency), more than that; at 0.1 m/s 1 cm, less.
+  Costmap raw(100, 100, 0.05, {0, 0});
+  raw.enableBoxes();
+  for (int x = 50; x <= 53; ++x) {
+    raw.setCost({x, 45}, cost::kLethal);  // face at y = 2.275 m, half-way up the cell
+    raw.setBox(raw.index({x, 45}), cell_box::pack(0, 0, 254, 127));
+    raw.setCost({x, 54}, cost::kLethal);  // face at y = 2.725 m
+    raw.setBox(raw.index({x, 54}), cell_box::pack(0, 127, 254, 254));
+  }
+  InflationParams ip;
+  ip.inscribed_radius = 0.2;
+  ip.inflation_radius = 0.6;
+  Costmap m = raw;
+  inflateWindow(raw, m, {0, 0, 100, 100}, ip);
+  refineNearBoxes(raw, m, {0, 0, 100, 100}, ip, 0.2);
+  const Eigen::Vector3d pose(2.35, 2.5, 0.0);
+  ASSERT_GE(footprintCost(m, pose, square()), 0) << "the footprint fits the gap";
+  LocalPlanner lp(tutorialParams(), square());
+  lp.setPlan(straightPlan({2.35, 2.5}, {4.0, 2.5}));
+  EXPECT_LT(lp.scoreTrajectory(m, pose, {0.1, 0, 0}, {0.3, 0, 0}), 0.0) << "full speed through the gap";
+  EXPECT_GE(lp.scoreTrajectory(m, pose, {0.1, 0, 0}, {0.1, 0, 0}), 0.0) << "slowly through the gap";
+  const Trajectory t = lp.findBestPath(m, pose, {0.1, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_GT(t.xv, 0.0);
+  EXPECT_LE(t.xv, 0.15);
+}

@@ -181,6 +181,24 @@ def test_layered_costmap_marks_clears_and_inflates_and_follows_a_growing_map():
     assert costs_of(lc)[hit[1], hit[0]] == FREE
 
 
+def test_footprint_clearing_keeps_a_return_outside_the_footprint_under_its_outline():
+    """A post 5 mm beside the padded footprint (0.21 m) lies in a cell the outline passes through:
+    costmap_2d's footprint clearing wipes it, and the robot would not see what stands beside it. Its
+    return lies outside the footprint, so it stays; a return inside the footprint (the robot's own
+    body) is cleared."""
+    lc = LayeredCostmap(CostmapConfig('local_costmap', tutorial_costmap('local_costmap'), lambda w: None), print)
+    pose = (2.0, 1.0, 0.0)
+    lc.update(pose)
+    # Beams to the left (+y) and to the right (-y): 0.215 m (outside) and 0.15 m (inside).
+    lc.add_scan('scan', 1.0, pose, 0.1, -np.pi / 2, np.pi, 0.1, 6.0, [0.15, 0.215])
+    lc.update(pose)
+    costs = costs_of(lc)
+    outside, inside = cell_of(lc, 2.0, 1.215), cell_of(lc, 2.0, 0.85)
+    assert outside[1] == cell_of(lc, 2.0, 1.21)[1]  # the outline (y = 1.21) passes through its cell
+    assert costs[outside[1], outside[0]] == LETHAL
+    assert costs[inside[1], inside[0]] != LETHAL
+
+
 def test_bounded_updates_equal_a_full_recomputation():
     """Each update redoes only the window that changed; the grid is the one a full recomputation gives."""
     cfg = CostmapConfig('global_costmap', tutorial_costmap('global_costmap'), lambda w: None)

@@ -29,14 +29,23 @@ double contactRadius(const Footprint& footprint);
 /// the origin (the robot's centre must lie inside its footprint).
 void validateFootprint(const Footprint& footprint);
 
+/// Whether the segment a-b meets the rectangle `rect` (min x, min y, max x, max y), any units.
+bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector4d& rect);
+
+/// Whether the footprint at `pose` (x, y, yaw) overlaps the world rectangle `rect` [m] (min x,
+/// min y, max x, max y): an edge crosses it, or it lies inside the outline.
+bool footprintMeetsRect(const Eigen::Vector3d& pose, const Footprint& footprint, const Eigen::Vector4d& rect);
+
 /// The highest cost under the footprint's outline at `pose` (x, y, yaw; costmap frame) as
 /// base_local_planner's CostmapModel checks it: -1 when any outline cell is lethal (254) or
 /// outside the map, else the maximum over the outline cells (unknown cells count as 255 only if
 /// `unknown_is_obstacle`, else are ignored). The outline's cells are every cell it passes through.
 /// A round footprint (robot_radius's 16-gon: at least 8 vertices, all as far from the centre) is
 /// checked as the circle through its vertices, so that its cost does not change as it turns.
+/// A lethal cell with a box (cell_box) counts only where the outline or the inside meets the box,
+/// grown by cell_box::kMargin plus `box_margin` [m]; else it costs 253.
 int footprintCost(const Costmap& map, const Eigen::Vector3d& pose, const Footprint& footprint,
-                  bool unknown_is_obstacle = false);
+                  bool unknown_is_obstacle = false, double box_margin = 0.0);
 
 }  // namespace core
 }  // namespace mbot

@@ -33,7 +33,9 @@ uint8_t inflatedCost(double distance_m, const InflationParams& params);
 /// cost (253) alone lets a planner put the centre where the local planner's footprint check fails.
 /// It is the cost at the largest cell-centre distance of a cell that can touch; 253 when that
 /// lies beyond inflation_radius (the costs cannot tell it apart) or the footprint is a point.
-uint8_t contactCost(const InflationParams& params, double resolution, double contact_radius);
+/// With `clearance` [m], the cost at that distance plus the clearance: below it the footprint
+/// keeps at least `clearance` from every obstacle (0 when that lies beyond inflation_radius).
+uint8_t contactCost(const InflationParams& params, double resolution, double contact_radius, double clearance = 0.0);
 
 /// A cell window [x0, x1) x [y0, y1) of a costmap (costmap_2d's update bounds, in cells).
 struct CellWindow {
@@ -54,6 +56,18 @@ void inflate(Costmap& map, const InflationParams& params);
 /// is read with a margin of the radius). Cells outside the window are not touched. `base` and
 /// `out` must have the same size. Work is proportional to the window, not the map.
 void inflateWindow(const Costmap& base, Costmap& out, const CellWindow& window, const InflationParams& params);
+
+/// Inflation near lethal cells that have boxes (Costmap::box): `out`'s cells inside `window` that
+/// are within reach of a contact and near a box take their cost from the clearance of the best of
+/// 3 x 3 points in the cell (at thirds of a cell): its distance to the nearest obstacle's outline
+/// (a box grown by cell_box::kMargin, or a whole cell), raised by the contact distance's rounding
+/// (contactCost's farthest touching centre less `contact_radius`). So a cost below contactCost
+/// means the footprint fits somewhere in the cell without touching an obstacle (the laser's
+/// precision, not the cell's), and a plan can pass a gap open only within a centimetre or two of
+/// its middle wherever the cell centres fall. Also copies `base`'s boxes into `out` over the
+/// window. Call after inflateWindow with the same arguments.
+void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window, const InflationParams& params,
+                     double contact_radius);
 
 }  // namespace core
 }  // namespace mbot

@@ -134,6 +134,12 @@ class LayeredCostmap {
   /// contactCost of this costmap's footprint, inflation and resolution: the lowest cost at which a
   /// centre's footprint may cover a lethal cell (253 without an inflation layer).
   uint8_t contactCost() const;
+  /// [m] The clearance a plan keeps where it can (roomyCost).
+  static constexpr double kRoomyClearance = 0.02;
+  /// The cost below which the footprint keeps kRoomyClearance from every obstacle (contactCost
+  /// without an inflation layer): the global planner's first threshold, so that a plan squeezes
+  /// through a gap with a centimetre to spare only where no roomier way is known.
+  uint8_t roomyCost() const;
 
   /// A mask for filter `index` of config().filters (OccupancyGrid data, as setMap). Throws
   /// std::invalid_argument saying why when it cannot be used (its size, or a resolution other
@@ -166,6 +172,7 @@ class LayeredCostmap {
     LaserScan scan;
   };
   void resize(int width, int height, const Eigen::Vector2d& origin, double resolution);
+  void enableBoxes();
   void compose(const CellWindow& window);
   void applyKeepout(const CellWindow& window);
   bool filterUsable(std::size_t index) const;

@@ -130,6 +130,15 @@ class LocalPlanner {
   /// lethal cell where the robot stood and a shrunken one let it move out (kEscapeScales).
   double lastFootprintScale() const { return footprint_scale_; }
   static constexpr double kEscapeScales[] = {0.9, 0.8, 0.7, 0.6, 0.5};
+  /// Tried first where the costmap has boxes (cell_box): a box's margin is a centimetre.
+  static constexpr double kBoxEscapeScales[] = {0.97, 0.94};
+  /// [s] A trajectory is checked against boxes (cell_box) grown by the distance its footprint's
+  /// farthest point moves in this time at the trajectory's speeds: the pose a command acts on is
+  /// older than the command (the laser's, tf's and the planner's latency), and the base follows
+  /// its command under acceleration limits. Whole cells have their rounding for that margin; a
+  /// box's centimetre is less than 0.3 m/s drives in 0.1 s, so through a gap the robot clears by
+  /// a centimetre or two it drives slowly.
+  static constexpr double kBoxLatency = 0.1;
   /// [m] The distance from the robot's centre to the nearest lethal cell inside its footprint (its
   /// inscribed circle) at the last findBestPath; infinity when none. While there is one, no step of
   /// a trajectory may come nearer to it (see useEscapeFootprint).
@@ -189,7 +198,7 @@ class LocalPlanner {
   /// this cycle says so in four lookups), every outline cell is free and the cost is 0.
   /// With `defer` (may be null), a footprint whose square holds no lethal or unknown cell is valid
   /// and its exact cost is left for later: *defer is set and a lower bound of it returned.
-  int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer = nullptr) const;
+  int footprintCostAt(const Costmap& map, const Eigen::Vector3d& pose, bool* defer = nullptr, double box_margin = 0.0) const;
   void buildNonZeroTable(const Costmap& map);
   void resetFlagsIfMoved(const Eigen::Vector3d& pose);
 
@@ -209,6 +218,7 @@ class LocalPlanner {
   std::vector<int> nonzero_, blocking_;  // blocking_: cells that are lethal or unknown
   int table_w_ = 0, table_h_ = 0;
   bool table_valid_ = false, shortcuts_ = true;
+  double box_latency_ = kBoxLatency;         // [s] kBoxLatency, or 0 where no move keeps its margin
   double circumscribed_ = 0.0;
   double footprint_scale_ = 1.0;
   double full_radius_ = 0.0;                 // circumscribed_ of the whole footprint while escaping
