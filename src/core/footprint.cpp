@@ -56,6 +56,8 @@ void validateFootprint(const Footprint& f) {
   if (!inside) throw std::invalid_argument("footprint does not contain the robot's centre (0, 0)");
 }
 
+namespace {
+/// Whether the segment a-b meets the rectangle (min x, min y, max x, max y) (Liang-Barsky clipping).
 bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector4d& box) {
   double t0 = 0.0, t1 = 1.0;
   const double d[2] = {b.x() - a.x(), b.y() - a.y()};
@@ -74,7 +76,6 @@ bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const 
   return true;
 }
 
-namespace {
 /// Even-odd test of point q against the polygon `corners[0..n)`.
 bool insidePolygon(const Eigen::Vector2d* corners, std::size_t n, const Eigen::Vector2d& q) {
   bool inside = false;

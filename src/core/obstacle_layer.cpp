@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "mbot_slam_navigation/core/bresenham.h"
-#include "mbot_slam_navigation/core/footprint.h"
 
 namespace mbot {
 namespace core {
@@ -55,17 +54,11 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
       const double clear_r = std::min(r, params.raytrace_range);
       const Cell clear_end = layer.worldToCell(origin + clear_r * dir);
       // Clear up to the end point's cell, never the end point itself (it is what the beam hit).
-      // A lethal cell with a box stays unless the beam passed through the box: a beam that grazes
-      // a post's edge cell and returns from behind it has not seen the post go (whole cells lose
-      // such edges, and a gap between two posts looks open again from farther away).
-      const Eigen::Vector2d beam_end = origin + clear_r * dir;
+      // A whole cell, box or not: a beam that misses a small box is no proof the obstacle stayed,
+      // and a person's marks must go when the person does (docs/experiments.md).
       walkLine(from, clear_end, [&](const Cell& c) {
         if (!layer.contains(c)) return false;
         if (is_return && c == end) return false;
-        if (layer.cost(c) == cost::kLethal && layer.box(layer.index(c)) != cell_box::kNoBox &&
-            !segmentMeetsRect(origin, beam_end, layer.obstacleBounds(c, 0.0))) {
-          return true;
-        }
         layer.setCost(c, cost::kFree);
         return true;
       });

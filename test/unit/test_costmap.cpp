@@ -356,6 +356,14 @@ TEST(CellBoxes, AMarkKeepsTheBoxOfItsReturnsAndAMapCellStaysWhole) {
     }
   }
   EXPECT_GT(marked, 6);
+  // The disc taken away (a person who walked on): the beams through its cells clear them all,
+  // small boxes or not.
+  Costmap gone = layer;
+  updateWithScan(gone, {0.4, 1.0, 0.0}, scanOfDiscs({0.4, 1.0, 0.0}, {}), p);
+  updateWithScan(gone, {1.6, 1.0, M_PI}, scanOfDiscs({1.6, 1.0, M_PI}, {}), p);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 40; ++x) EXPECT_NE(gone.cost({x, y}), cost::kLethal) << "a mark left at " << x << ", " << y;
+  }
   // The whole grid filled again: no box outlives its mark.
   layer.fill(cost::kLethal);
   EXPECT_EQ(layer.box(layer.index({20, 20})), cell_box::kNoBox);

@@ -29,9 +29,6 @@ double contactRadius(const Footprint& footprint);
 /// the origin (the robot's centre must lie inside its footprint).
 void validateFootprint(const Footprint& footprint);
 
-/// Whether the segment a-b meets the rectangle `rect` (min x, min y, max x, max y), any units.
-bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector4d& rect);
-
 /// Whether the footprint at `pose` (x, y, yaw) overlaps the world rectangle `rect` [m] (min x,
 /// min y, max x, max y): an edge crosses it, or it lies inside the outline.
 bool footprintMeetsRect(const Eigen::Vector3d& pose, const Footprint& footprint, const Eigen::Vector4d& rect);

@@ -9,7 +9,9 @@
 //     when too_close_is_obstacle (ours; costmap_2d drops it): a person who walks into the robot
 //     and covers its laser is then in the costmap, where the robot is, and it does not drive on
 //     into them on the strength of marks from before;
-//   - NaN, finite returns below range_min (drivers' error codes) and -inf otherwise do nothing.
+//   - NaN, finite returns below range_min (drivers' error codes) and -inf otherwise do nothing;
+//   - a layer with boxes (Costmap::enableBoxes) keeps in each marked cell the box of its returns
+//     (cell_box), grown by later returns while the cell stays lethal; -inf marks are whole cells.
 // Frames: `sensor_pose` is the laser in the costmap's global frame (x [m], y [m], yaw [rad]).
 #pragma once
 
