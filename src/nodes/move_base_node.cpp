@@ -202,7 +202,7 @@ class MoveBase {
 
   // --- planning -------------------------------------------------------------------------------------
   /// Plans on the global costmap; false with `why` when there is no plan. `used_lethal_cost`: the
-  /// lethal_cost the plan was made with. `roomy`: whether a roomy way is tried first; set false
+  /// lethal_cost the plan was made with. `roomy_first`: whether a roomy way is tried first; set false
   /// when none was found but a tighter one was (a goal's later plans then go straight to the
   /// tighter rule: a roomy way through space not seen yet would turn the robot from the way it
   /// found, back and forth between the two).
@@ -229,7 +229,7 @@ class MoveBase {
         p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
         if (roomy_first && p.status == core::PlanStatus::kOk) *roomy_first = false;
       } else {
-        lethal = roomy;
+        lethal = roomy;  // the plan, or why there is none, is the first rule's
       }
       if (p.status == core::PlanStatus::kNoPath && auto_lethal_cost_ && lethal < core::cost::kInscribed) {
         // No way keeps the footprint clear at every cell centre: one through cells where it may
