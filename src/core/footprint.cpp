@@ -45,15 +45,18 @@ double circumscribedRadius(const Footprint& f) {
   return best;
 }
 
+bool insidePolygon(const Eigen::Vector2d* corners, std::size_t n, const Eigen::Vector2d& q) {
+  bool inside = false;
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Eigen::Vector2d &a = corners[i], &b = corners[j];
+    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
+  }
+  return inside;
+}
+
 void validateFootprint(const Footprint& f) {
   if (f.size() < 3) throw std::invalid_argument("footprint needs at least 3 points, got " + std::to_string(f.size()));
-  bool inside = false;  // even-odd test of the origin
-  for (std::size_t i = 0, j = f.size() - 1; i < f.size(); j = i++) {
-    if ((f[i].y() > 0) != (f[j].y() > 0) && 0 < (f[j].x() - f[i].x()) * (0 - f[i].y()) / (f[j].y() - f[i].y()) + f[i].x()) {
-      inside = !inside;
-    }
-  }
-  if (!inside) throw std::invalid_argument("footprint does not contain the robot's centre (0, 0)");
+  if (!insidePolygon(f.data(), f.size(), Eigen::Vector2d::Zero())) throw std::invalid_argument("footprint does not contain the robot's centre (0, 0)");
 }
 
 namespace {
@@ -76,15 +79,6 @@ bool segmentMeetsRect(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const 
   return true;
 }
 
-/// Even-odd test of point q against the polygon `corners[0..n)`.
-bool insidePolygon(const Eigen::Vector2d* corners, std::size_t n, const Eigen::Vector2d& q) {
-  bool inside = false;
-  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
-    const Eigen::Vector2d &a = corners[i], &b = corners[j];
-    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
-  }
-  return inside;
-}
 
 /// A lethal cell's box in the grid's cell units, grown by cell_box::kMargin plus `extra` [m].
 Eigen::Vector4d boxInCells(const Costmap& map, const Cell& c, double extra) {
@@ -137,9 +131,7 @@ int ringCost(const Costmap& map, double x, double y, double radius, bool unknown
       const uint8_t v = row[i];
       if (v == cost::kLethal && map.box(static_cast<std::size_t>(j) * w + i) != cell_box::kNoBox) {
         // The obstacle's box, not the whole cell: touched when nearer to the centre than r.
-        const Eigen::Vector4d b = boxInCells(map, {i, j}, box_margin);
-        const double dx = std::max({b[0] - cx, 0.0, cx - b[2]}), dy = std::max({b[1] - cy, 0.0, cy - b[3]});
-        if (dx * dx + dy * dy < r2) return -1;
+        if (cell_box::squaredDistance(boxInCells(map, {i, j}, box_margin), cx, cy) < r2) return -1;
         worst = std::max(worst, static_cast<int>(cost::kInscribed));
         continue;
       }

@@ -254,12 +254,11 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
     for (int x = read.x0; x < read.x1; ++x) {
       if (row[x] != cost::kLethal) continue;
       const bool boxed = base.box(static_cast<std::size_t>(y) * w + x) != cell_box::kNoBox;
-      rows[y - read.y0].push_back({x, boxed, base.obstacleBounds({x, y}, boxed ? cell_box::kMargin : 0.0)});
+      rows[y - read.y0].push_back({x, boxed, base.obstacleBounds({x, y}, cell_box::kMargin)});
     }
   }
-  auto squaredDistance = [](const Eigen::Vector4d& b, const Eigen::Vector2d& at) {
-    const double dx = std::max({b[0] - at.x(), 0.0, at.x() - b[2]}), dy = std::max({b[1] - at.y(), 0.0, at.y() - b[3]});
-    return dx * dx + dy * dy;
+  auto squaredDistance = [](const Eigen::Vector4d& rect, const Eigen::Vector2d& at) {
+    return cell_box::squaredDistance(rect, at.x(), at.y());
   };
   const double spread = res / 3.0 * std::sqrt(2.0);  // [m] from a cell's centre to its farthest sample point
   std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (centre distance [m], rectangle)

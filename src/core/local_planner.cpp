@@ -191,13 +191,7 @@ std::vector<Cell> footprintCells(const Costmap& map, const Eigen::Vector3d& pose
   // Interior: cell centres inside the polygon (even-odd rule).
   for (int y = lo.y; y <= hi.y; ++y) {
     for (int x = lo.x; x <= hi.x; ++x) {
-      const Eigen::Vector2d q = map.cellCenter({x, y});
-      bool inside = false;
-      for (std::size_t i = 0, j = world.size() - 1; i < world.size(); j = i++) {
-        const auto &a = world[i], &b = world[j];
-        if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
-      }
-      if (inside) add({x, y});
+      if (insidePolygon(world.data(), world.size(), map.cellCenter({x, y}))) add({x, y});
     }
   }
   return cells;
@@ -504,7 +498,7 @@ void LocalPlanner::restoreFootprint(const Footprint& full) {
 double LocalPlanner::nearestLethal(const Costmap& map, const Eigen::Vector2d& at, double within) const {
   // The cells of the square around `at`, as squares (so the distance to a straight wall does not
   // change along it): a few dozen at these radii, and only while escaping.
-  const double res = map.resolution(), half = 0.5 * res;
+  const double res = map.resolution();
   const int reach = static_cast<int>(std::ceil(within / res)) + 1;
   const Cell c0 = map.worldToCell(at);
   double best = std::numeric_limits<double>::infinity();
@@ -512,14 +506,8 @@ double LocalPlanner::nearestLethal(const Costmap& map, const Eigen::Vector2d& at
     for (int dx = -reach; dx <= reach; ++dx) {
       const Cell c{c0.x + dx, c0.y + dy};
       if (!map.contains(c) || map.cost(c) != cost::kLethal) continue;
-      double d;
-      if (map.box(map.index(c)) != cell_box::kNoBox) {
-        const Eigen::Vector4d b = map.obstacleBounds(c, cell_box::kMargin);
-        d = std::hypot(std::max({b[0] - at.x(), 0.0, at.x() - b[2]}), std::max({b[1] - at.y(), 0.0, at.y() - b[3]}));
-      } else {
-        const Eigen::Vector2d off = (map.cellCenter(c) - at).cwiseAbs().array() - half;
-        d = off.cwiseMax(0.0).norm();
-      }
+      // To the cell's square, or to its box (grown by the box margin).
+      const double d = std::sqrt(cell_box::squaredDistance(map.obstacleBounds(c, cell_box::kMargin), at.x(), at.y()));
       if (d <= within && d < best) best = d;
     }
   }

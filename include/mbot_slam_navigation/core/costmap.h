@@ -6,6 +6,7 @@
 // global frame, rows grow with y.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,12 @@ inline int y1(uint32_t b) { return (b >> 24) & 0xFF; }
 uint32_t ofPoint(double fx, double fy);
 /// `box` grown to hold the point at fraction (fx, fy); kNoBox stays kNoBox.
 uint32_t grow(uint32_t box, double fx, double fy);
+/// Squared distance from point (x, y) to the rectangle `rect` (min x, min y, max x, max y), in
+/// the units of both; 0 inside.
+inline double squaredDistance(const Eigen::Vector4d& rect, double x, double y) {
+  const double dx = std::max({rect[0] - x, 0.0, x - rect[2]}), dy = std::max({rect[1] - y, 0.0, y - rect[3]});
+  return dx * dx + dy * dy;
+}
 }  // namespace cell_box
 
 class Costmap {

@@ -29,6 +29,9 @@ double contactRadius(const Footprint& footprint);
 /// the origin (the robot's centre must lie inside its footprint).
 void validateFootprint(const Footprint& footprint);
 
+/// Even-odd test of point `q` against the polygon `corners[0..n)` (any frame, any units).
+bool insidePolygon(const Eigen::Vector2d* corners, std::size_t n, const Eigen::Vector2d& q);
+
 /// Whether the footprint at `pose` (x, y, yaw) overlaps the world rectangle `rect` [m] (min x,
 /// min y, max x, max y): an edge crosses it, or it lies inside the outline.
 bool footprintMeetsRect(const Eigen::Vector3d& pose, const Footprint& footprint, const Eigen::Vector4d& rect);
