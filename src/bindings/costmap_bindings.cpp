@@ -93,8 +93,9 @@ void bindCostmaps(py::module& m) {
           [](Costmap& c, const Eigen::Vector3d& sensor_pose, double angle_min, double angle_increment, double range_min,
              double range_max, const py::array_t<float, py::array::c_style | py::array::forcecast>& ranges,
              double obstacle_range, double raytrace_range, bool marking, bool clearing, bool inf_is_valid,
-             bool too_close_is_obstacle) {
+             bool too_close_is_obstacle, double raytrace_end_margin) {
             mbot::core::ObservationSourceParams p;
+            p.raytrace_end_margin = raytrace_end_margin;
             p.obstacle_range = obstacle_range;
             p.raytrace_range = raytrace_range;
             p.marking = marking;
@@ -108,7 +109,8 @@ void bindCostmaps(py::module& m) {
           py::arg("sensor_pose"), py::arg("angle_min"), py::arg("angle_increment"), py::arg("range_min"),
           py::arg("range_max"), py::arg("ranges"), py::arg("obstacle_range"), py::arg("raytrace_range"),
           py::arg("marking") = true, py::arg("clearing") = true, py::arg("inf_is_valid") = true,
-          py::arg("too_close_is_obstacle") = true)
+          py::arg("too_close_is_obstacle") = true,
+          py::arg("raytrace_end_margin") = mbot::core::ObservationSourceParams().raytrace_end_margin)
       .def(
           "footprint_cost",
           [](const Costmap& c, const Eigen::Vector3d& pose, const std::vector<Eigen::Vector2d>& footprint,

@@ -506,5 +506,35 @@ bool GlobalPlanner::searchAStar(const Costmap& map, int start, int goal, Plan& p
   return true;
 }
 
+namespace {
+double pathLength(const std::vector<Eigen::Vector2d>& path) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
+  return length;
+}
+}  // namespace
+
+Plan planPreferringRoom(GlobalPlanner& planner, const Costmap& map, const Eigen::Vector2d& start,
+                        const Eigen::Vector2d& goal, int roomy_cost, int lethal_cost, double max_detour_m,
+                        int* used_cost) {
+  int used = roomy_cost;
+  planner.setLethalCost(roomy_cost);
+  Plan roomy = planner.makePlan(map, start, goal);
+  if (roomy_cost < lethal_cost &&
+      (roomy.status == PlanStatus::kNoPath ||
+       (roomy.status == PlanStatus::kOk && pathLength(roomy.path) - (goal - start).norm() > max_detour_m))) {
+    planner.setLethalCost(lethal_cost);
+    Plan tight = planner.makePlan(map, start, goal);
+    const bool keep_roomy = roomy.status == PlanStatus::kOk &&
+                            (tight.status != PlanStatus::kOk || pathLength(roomy.path) <= pathLength(tight.path) + max_detour_m);
+    if (!keep_roomy) {
+      roomy = std::move(tight);
+      used = lethal_cost;
+    }
+  }
+  if (used_cost) *used_cost = used;
+  return roomy;
+}
+
 }  // namespace core
 }  // namespace mbot

@@ -88,6 +88,11 @@ ObservationSourceConfig readSource(const std::string& name, const ParamValue& va
                               layer.number("raytrace_range", s.raytrace_range, "[m] farthest beam that clears (layer default)",
                                            std::nullopt, true),
                               "[m] farthest a beam clears free space", std::nullopt, true);
+  s.raytrace_end_margin = r.number("raytrace_end_margin", s.raytrace_end_margin,
+                                   "[m] a return's beam clears only the cells it leaves more than this short of the return, so "
+                                   "that the laser's noise does not erase the cell in front of a surface (ours; 0: costmap_2d's "
+                                   "rule)",
+                                   0.0);
   s.inf_is_valid = r.boolean("inf_is_valid", s.inf_is_valid,
                              "an infinite range clears the beam's whole length (ROS's default false: it clears nothing)");
   s.too_close_is_obstacle = r.boolean("too_close_is_obstacle", s.too_close_is_obstacle,
@@ -793,6 +798,7 @@ CellWindow LayeredCostmap::update(const Eigen::Vector3d& robot_pose) {
       ObservationSourceParams p;
       p.obstacle_range = src.obstacle_range;
       p.raytrace_range = src.raytrace_range;
+      p.raytrace_end_margin = src.raytrace_end_margin;
       p.marking = src.marking;
       p.clearing = src.clearing;
       p.inf_is_valid = src.inf_is_valid;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <unordered_set>
 
 #include "mbot_slam_navigation/core/bresenham.h"
 
@@ -14,6 +15,11 @@ void ObservationSourceParams::validate() const {
   if (!(obstacle_range > 0.0)) throw std::invalid_argument("obstacle_range must be positive");
   if (!(raytrace_range > 0.0)) throw std::invalid_argument("raytrace_range must be positive");
 }
+
+namespace {
+/// [m] Neighbouring returns this close in range lie on one surface (for the median of three).
+constexpr double kSameSurface_m = 0.05;
+}  // namespace
 
 int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const LaserScan& scan,
                    const ObservationSourceParams& params, std::vector<Cell>* too_close) {
@@ -51,32 +57,56 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
     const Eigen::Vector2d dir(std::cos(a), std::sin(a));
     const Cell end = layer.worldToCell(origin + r * dir);
     if (params.clearing) {
-      const double clear_r = std::min(r, params.raytrace_range);
-      const Cell clear_end = layer.worldToCell(origin + clear_r * dir);
-      // Clear up to the end point's cell, never the end point itself (it is what the beam hit).
+      // A return clears the cells the beam leaves more than raytrace_end_margin short of its end,
+      // never the end point's cell (it is what the beam hit): the returns off one surface scatter
+      // by the laser's noise, and a beam ending just past a cell border must not erase the cell
+      // in front of it that the previous scan's returns marked (the surface would flicker between
+      // the two cells, a gap one cell wider and narrower from scan to scan).
+      const double short_r = is_return ? r - params.raytrace_end_margin : r;
+      const bool stop_short = short_r < params.raytrace_range;
+      const double clear_r = std::min(short_r, params.raytrace_range);
+      const Cell clear_end = layer.worldToCell(origin + std::max(0.0, clear_r) * dir);
       // A whole cell, box or not: a beam that misses a small box is no proof the obstacle stayed,
       // and a person's marks must go when the person does (docs/experiments.md).
-      walkLine(from, clear_end, [&](const Cell& c) {
-        if (!layer.contains(c)) return false;
-        if (is_return && c == end) return false;
-        layer.setCost(c, cost::kFree);
-        return true;
-      });
+      if (clear_r > 0.0) {
+        walkLine(from, clear_end, [&](const Cell& c) {
+          if (!layer.contains(c)) return false;
+          if (is_return && (c == end || (stop_short && params.raytrace_end_margin > 0.0 && c == clear_end))) return false;
+          layer.setCost(c, cost::kFree);
+          return true;
+        });
+      }
     }
     if (params.marking && is_return && r < params.obstacle_range && layer.contains(end)) {
-      marks.push_back({end, (origin + r * dir - layer.origin()) / layer.resolution()});
+      // A box is placed by the median of the beam's and its neighbours' ranges where the three
+      // lie on one surface: the laser's noise, which would spread the box towards the robot,
+      // shrinks to about two thirds, and a point off a surface's edge keeps its own range.
+      double at_r = r;
+      if (layer.hasBoxes() && i > 0 && i + 1 < scan.ranges_m.size()) {
+        const double a0 = scan.ranges_m[i - 1], a2 = scan.ranges_m[i + 1];
+        if (std::isfinite(a0) && std::isfinite(a2) && std::abs(a0 - r) <= kSameSurface_m &&
+            std::abs(a2 - r) <= kSameSurface_m) {
+          at_r = std::max(std::min(a0, a2), std::min(std::max(a0, a2), r));
+        }
+      }
+      const Cell at_cell = layer.worldToCell(origin + at_r * dir);
+      if (layer.contains(at_cell)) marks.push_back({at_cell, (origin + at_r * dir - layer.origin()) / layer.resolution()});
     }
   }
-  // After clearing, as costmap_2d. A cell lethal before (and not cleared since) grows its box.
+  // After clearing, as costmap_2d. A marked cell's box is that of this scan's returns in it: the
+  // returns off a surface scatter by the laser's noise towards the robot and away, and a box
+  // grown by every scan's would reach out by the largest deviation of hundreds (2.5 standard
+  // deviations), enough to shut a gap that leaves the robot 2-3 cm a side.
+  std::unordered_set<std::size_t> boxed;  // cells given a box by this scan
   for (const Mark& m : marks) {
     const std::size_t i = layer.index(m.cell);
-    const bool fresh = layer.cost(m.cell) != cost::kLethal;
     layer.setCost(m.cell, cost::kLethal);
     if (std::isnan(m.at.x())) {
       layer.setBox(i, cell_box::kNoBox);
+      boxed.insert(i);  // a whole cell, whatever else this scan saw in it
     } else {
       const double fx = m.at.x() - m.cell.x, fy = m.at.y() - m.cell.y;
-      layer.setBox(i, fresh ? cell_box::ofPoint(fx, fy) : cell_box::grow(layer.box(i), fx, fy));
+      layer.setBox(i, boxed.insert(i).second ? cell_box::ofPoint(fx, fy) : cell_box::grow(layer.box(i), fx, fy));
     }
   }
   return static_cast<int>(marks.size());

@@ -202,35 +202,25 @@ class MoveBase {
 
   // --- planning -------------------------------------------------------------------------------------
   /// Plans on the global costmap; false with `why` when there is no plan. `used_lethal_cost`: the
-  /// lethal_cost the plan was made with. `roomy_first`: whether a roomy way is tried first; set false
-  /// when none was found but a tighter one was (a goal's later plans then go straight to the
-  /// tighter rule: a roomy way through space not seen yet would turn the robot from the way it
-  /// found, back and forth between the two).
+  /// lethal_cost the plan was made with.
   bool plan(core::GlobalPlanner& planner, const Vec3& start, const Vec3& goal, Path2& path, std::string& why,
-            int* used_lethal_cost = nullptr, bool* roomy_first = nullptr) {
+            int* used_lethal_cost = nullptr) {
     double resolution;
     core::Plan p;
     int lethal;
     {
       auto guard = global_->lock();
       lethal = lethalCost();
-      // A way with room to spare first (in clutter a plan through a gap the footprint clears by a
-      // centimetre is a slow one to drive), then one where the footprint just clears. Not when the
-      // robot or the goal stands where there is no such room: that plan would start or end elsewhere.
+      // A way with room to spare where it is not much longer (in clutter a plan through a gap the
+      // footprint clears by a centimetre is a slow one to drive), else one where the footprint just
+      // clears. Not when the robot or the goal stands where there is no such room: that plan would
+      // start or end elsewhere.
       const core::Costmap& m = global_->master();
       const core::Cell sc = m.worldToCell(start.head<2>()), gc = m.worldToCell(goal.head<2>());
       int roomy = auto_lethal_cost_ ? global_->roomyCost() : lethal;
       if (!m.contains(sc) || !m.contains(gc) || m.cost(sc) >= roomy || m.cost(gc) >= roomy) roomy = lethal;
-      if (roomy_first && !*roomy_first) roomy = lethal;
-      planner.setLethalCost(roomy);
-      p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
-      if (p.status == core::PlanStatus::kNoPath && roomy < lethal) {
-        planner.setLethalCost(lethal);
-        p = planner.makePlan(global_->master(), start.head<2>(), goal.head<2>());
-        if (roomy_first && p.status == core::PlanStatus::kOk) *roomy_first = false;
-      } else {
-        lethal = roomy;  // the plan, or why there is none, is the first rule's
-      }
+      p = core::planPreferringRoom(planner, m, start.head<2>(), goal.head<2>(), roomy, lethal, core::kMaxRoomyDetour_m,
+                                   &lethal);
       if (p.status == core::PlanStatus::kNoPath && auto_lethal_cost_ && lethal < core::cost::kInscribed) {
         // No way keeps the footprint clear at every cell centre: one through cells where it may
         // touch (ROS's rule) is still worth trying, the robot is not held to cell centres. (A
@@ -351,7 +341,6 @@ class MoveBase {
     header.stamp = ros::Time::now();
     goal_pub_.publish(poseStamped(header, goal->x(), goal->y(), goal->z()));
     ROS_INFO("move_base: new goal (%.2f, %.2f, %.2f rad) in %s", goal->x(), goal->y(), goal->z(), header.frame_id.c_str());
-    roomy_first_ = true;
     return goal;
   }
 
@@ -422,7 +411,7 @@ class MoveBase {
       return current;
     }
     bool makePlan(const Vec3& start, const Vec3& goal, Path2& path, std::string& why) override {
-      return mb_.plan(*mb_.planner_, start, goal, path, why, &mb_.plan_lethal_cost_, &mb_.roomy_first_);
+      return mb_.plan(*mb_.planner_, start, goal, path, why, &mb_.plan_lethal_cost_);
     }
     bool planBlocked(const Path2& path, const Vec3& pose) override {
       auto guard = mb_.global_->lock();
@@ -713,7 +702,6 @@ class MoveBase {
   std::unique_ptr<core::GlobalPlanner> planner_, service_planner_;
   bool auto_lethal_cost_ = true;
   int plan_lethal_cost_ = core::cost::kInscribed;  // the lethal_cost the followed plan was made with
-  bool roomy_first_ = true;                         // this goal's plans try a roomy way first (plan())
   /// The global planner's lethal_cost (the global costmap's lock held).
   int lethalCost() const { return auto_lethal_cost_ ? global_->contactCost() : config_.planner.lethal_cost; }
   std::unique_ptr<core::TrajectoryController> controller_;

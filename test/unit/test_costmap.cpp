@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -289,6 +290,30 @@ TEST(ObstacleLayer, ClearingStopsAtRaytraceRange) {
   EXPECT_EQ(layer.cost(layer.worldToCell({4.0, 0.0})), cost::kLethal);  // not marked anew, not cleared
 }
 
+TEST(ObstacleLayer, ReturnsScatteredAcrossACellBorderDoNotEraseEachOther) {
+  // A wall 1.0 m east whose face lies on a cell border: with the laser's noise, one scan's return
+  // falls just short of the border, the next one's just past it. The second beam passes the first
+  // return's cell within the noise of its end: that cell keeps its mark (raytrace_end_margin), and
+  // the wall stays one surface instead of flickering between the two cells. costmap_2d's rule
+  // (margin 0) erases it.
+  for (double margin : {0.03, 0.0}) {
+    Costmap layer(100, 100, 0.05, {-2.5, -2.5}, cost::kNoInformation);
+    ObservationSourceParams p;
+    p.raytrace_end_margin = margin;
+    updateWithScan(layer, {0, 0, 0}, fan({0.995f}), p);
+    const Cell near = layer.worldToCell({0.995, 0.0}), far = layer.worldToCell({1.005, 0.0});
+    ASSERT_NE(near.x, far.x);
+    updateWithScan(layer, {0, 0, 0}, fan({1.005f}), p);
+    EXPECT_EQ(layer.cost(far), cost::kLethal);
+    EXPECT_EQ(layer.cost(near), margin > 0.0 ? cost::kLethal : cost::kFree) << "margin " << margin;
+    // Farther from the new end than the margin, a mark is cleared as before (an obstacle gone).
+    updateWithScan(layer, {0, 0, 0}, fan({1.2f}), p);
+    EXPECT_EQ(layer.cost(near), cost::kFree);
+    EXPECT_EQ(layer.cost(far), cost::kFree);
+    EXPECT_EQ(layer.cost(layer.worldToCell({0.5, 0.0})), cost::kFree);
+  }
+}
+
 TEST(ObstacleLayer, MinusInfinityMarksRangeMinAndDriverErrorCodesDoNothing) {
   // A person covers the laser: REP 117's -inf (nearer than range_min). It is marked at range_min
   // along the beam, so the costmap has it where the robot is; a finite reading below range_min (a
@@ -402,6 +427,36 @@ TEST(CellBoxes, AGapJustWiderThanTheRobotIsOpenToTheLaserAndShutToWholeCells) {
       EXPECT_EQ(planner_open, boxes && gap > 0.44);
     }
   }
+}
+
+TEST(CellBoxes, TheLasersNoiseDoesNotShutAGapOverTime) {
+  // Two posts 0.46 m apart and the mbot (radius 0.2 m) in the gap's middle: 3 cm a side, 2 cm
+  // beyond the boxes' 1 cm margin. A laser with 1 cm of noise (the simulated Hokuyo's) watches the
+  // gap for 10 s (100 scans). A box holds the latest scan's returns, so the gap stays open in most
+  // scans; boxes grown by every scan's returns reach out by the largest deviation of hundreds, and
+  // shut it for good within a few seconds.
+  const Footprint fp = circleFootprint(0.2);
+  const double y = 1.5, r = 0.1, gap = 0.46;
+  const std::vector<Eigen::Vector3d> posts = {{1.5, y - gap / 2 - r, r}, {1.5, y + gap / 2 + r, r}};
+  const Eigen::Vector3d laser(1.5, y, 0.0);
+  Costmap layer(60, 60, 0.05, {0, 0});
+  layer.enableBoxes();
+  ObservationSourceParams p;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  int open = 0, open_late = 0;
+  for (int k = 0; k < 100; ++k) {
+    LaserScan scan = scanOfDiscs(laser, posts);
+    for (float& range : scan.ranges_m) {
+      if (std::isfinite(range)) range += static_cast<float>(noise(rng));
+    }
+    updateWithScan(layer, laser, scan, p);
+    const bool is_open = footprintCost(layer, {1.5, y, 0.0}, fp) >= 0;
+    open += is_open;
+    if (k >= 50) open_late += is_open;
+  }
+  EXPECT_GE(open, 80) << open_late;
+  EXPECT_GE(open_late, 40) << "the gap shut as the scans went on";
 }
 
 TEST(CellBoxes, AFootprintInACellBelowTheContactCostFitsWithoutTouchingABox) {

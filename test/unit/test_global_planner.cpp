@@ -127,6 +127,51 @@ TEST_P(BothPlanners, CellsAtLethalCostOrAboveAreObstacles) {
   EXPECT_THROW(planner.setLethalCost(254), std::invalid_argument);
 }
 
+TEST_P(BothPlanners, ARoomyWayIsTakenOnlyWhenItIsNotMuchLonger) {
+  // A wall at x = 2.0 m with a tight gap (cost 230) on the straight line and a roomy way round its
+  // end. Roomy threshold 220, contact threshold 253: the way round is taken when it is at most
+  // max_detour_m longer than the way through the gap, the gap otherwise.
+  auto world = [](int wall_to_y) {
+    Costmap m(40, 60, 0.1, {0, 0});
+    for (int y = 0; y < wall_to_y; ++y) m.setCost({20, y}, cost::kLethal);
+    m.setCost({20, 5}, 230);  // the gap, on the line y = 0.55
+    return m;
+  };
+  PlannerParams p;
+  p.use_astar = GetParam();
+  GlobalPlanner planner(p);
+  const Eigen::Vector2d start(0.55, 0.55), goal(3.55, 0.55);
+  auto throughGap = [](const Costmap& m, const Plan& plan) {
+    for (const auto& q : plan.path) {
+      if (m.worldToCell(q) == Cell{20, 5}) return true;
+    }
+    return false;
+  };
+  int used = 0;
+  // The wall ends at y = 3.0 m: round it is about 3 m longer than through the gap.
+  const Costmap short_wall = world(30);
+  Plan plan = planPreferringRoom(planner, short_wall, start, goal, 220, cost::kInscribed, 4.0, &used);
+  ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
+  EXPECT_FALSE(throughGap(short_wall, plan)) << "a detour within max_detour_m keeps room";
+  EXPECT_EQ(used, 220);
+  plan = planPreferringRoom(planner, short_wall, start, goal, 220, cost::kInscribed, 2.0, &used);
+  ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
+  EXPECT_TRUE(throughGap(short_wall, plan)) << "a detour beyond max_detour_m is not worth the room";
+  EXPECT_EQ(used, cost::kInscribed);
+  EXPECT_LT(pathLength(plan.path), 3.5);
+  // No way round: the gap, whatever the detour allowed.
+  const Costmap closed = world(60);
+  plan = planPreferringRoom(planner, closed, start, goal, 220, cost::kInscribed, 100.0, &used);
+  ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
+  EXPECT_TRUE(throughGap(closed, plan));
+  EXPECT_EQ(used, cost::kInscribed);
+  // Nothing tight on an open floor: one search, the roomy rule's.
+  const Costmap open(40, 60, 0.1, {0, 0});
+  plan = planPreferringRoom(planner, open, start, goal, 220, cost::kInscribed, 0.5, &used);
+  ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
+  EXPECT_EQ(used, 220);
+}
+
 TEST_P(BothPlanners, GoalInAWallMovesWithinTheTolerance) {
   const Costmap m = wallMap();
   PlannerParams p;

@@ -63,6 +63,25 @@ struct Plan {
   int coarse_blocks = 0;              ///< blocks the coarse search visited
 };
 
+class GlobalPlanner;
+
+/// [m] How much longer a roomy way may be than the tightest one and still be taken. Through a gap
+/// the footprint clears by a centimetre or two the robot drives at a third of its speed or less
+/// (the local planner's latency margin) for about a metre; 2 m at full speed is that time. A
+/// longer detour, without a map mostly through space not seen yet, costs more than the gap.
+constexpr double kMaxRoomyDetour_m = 2.0;
+
+/// A plan that keeps room to spare where that costs little. Plans with `roomy_cost` as lethal
+/// first; plans again with `lethal_cost` when that finds no way, or when its way may be more than
+/// `max_detour_m` longer than the tighter one's (the second search runs only when the roomy way
+/// exceeds the straight line by more than `max_detour_m`), and then takes the tighter way unless
+/// the roomy one is within `max_detour_m` of it. `used_cost` (optional): the lethal cost of the
+/// returned plan (for a failure, of the last search). The planner's lethal cost is left at
+/// `lethal_cost`'s after a second search, at `roomy_cost` otherwise.
+Plan planPreferringRoom(GlobalPlanner& planner, const Costmap& map, const Eigen::Vector2d& start,
+                        const Eigen::Vector2d& goal, int roomy_cost, int lethal_cost,
+                        double max_detour_m = kMaxRoomyDetour_m, int* used_cost = nullptr);
+
 class GlobalPlanner {
  public:
   explicit GlobalPlanner(const PlannerParams& params = PlannerParams());

@@ -58,6 +58,7 @@ struct ObservationSourceConfig {
   bool clearing = false, marking = true;
   double max_obstacle_height = 2.0, min_obstacle_height = 0.0;       ///< [m]
   double obstacle_range = 2.5, raytrace_range = 3.0;                 ///< [m]
+  double raytrace_end_margin = 0.03;  ///< [m] ours: ObservationSourceParams::raytrace_end_margin
   bool inf_is_valid = true;  ///< ROS's default is false (then +inf clears nothing); see docs/navigation.md
   bool too_close_is_obstacle = true;  ///< ours: -inf marks range_min (costmap_2d ignores it)
 };

@@ -3,6 +3,7 @@
 // points as lethal. Ranges follow REP 117.
 //   - marking: a return closer than obstacle_range marks its end cell lethal;
 //   - clearing: every beam clears up to its end (exclusive) or raytrace_range, whichever is nearer;
+//     a return's beam stops raytrace_end_margin short of the return (the laser's noise);
 //     +inf (no return within range_max) clears to min(raytrace_range, range_max) when
 //     inf_is_valid, as costmap_2d does for `inf_is_valid: true`;
 //   - -inf (REP 117: an object nearer than range_min) marks the cell at range_min along its beam
@@ -10,8 +11,8 @@
 //     and covers its laser is then in the costmap, where the robot is, and it does not drive on
 //     into them on the strength of marks from before;
 //   - NaN, finite returns below range_min (drivers' error codes) and -inf otherwise do nothing;
-//   - a layer with boxes (Costmap::enableBoxes) keeps in each marked cell the box of its returns
-//     (cell_box), grown by later returns while the cell stays lethal; -inf marks are whole cells.
+//   - a layer with boxes (Costmap::enableBoxes) keeps in each marked cell the box of the latest
+//     scan's returns in it (cell_box); -inf marks are whole cells.
 // Frames: `sensor_pose` is the laser in the costmap's global frame (x [m], y [m], yaw [rad]).
 #pragma once
 
@@ -28,6 +29,9 @@ namespace core {
 struct ObservationSourceParams {
   double obstacle_range = 2.5;   ///< [m] `obstacle_range` (costmap_2d default 2.5)
   double raytrace_range = 3.0;   ///< [m] `raytrace_range` (default 3.0)
+  /// [m] A return clears only the cells its beam leaves more than this short of its end (ours;
+  /// 0: costmap_2d's rule, every cell but the end's).
+  double raytrace_end_margin = 0.03;
   bool marking = true;
   bool clearing = true;
   bool inf_is_valid = true;      ///< +inf clears (a simulated or real laser that reports "nothing")
