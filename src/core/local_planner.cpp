@@ -23,6 +23,13 @@ constexpr double kFacingAway_rad = M_PI / 3.0;
 // enough that the cells' 45-degree steps average out, near enough to be the way out of where it
 // stands.
 constexpr double kTurnLookahead_m = 0.5;
+// [m] The local goal (what the goal distances lead to) lies at most this far along the plan ahead
+// of the robot (Nav2's DWB prunes its plan so, forward_prune_distance 2.0 m). ROS takes the plan's
+// last point in the local costmap, up to 3.5 m away: the goal distances count cells, not the
+// global planner's costs, and around a cluster of obstacles a shorter way to that point through
+// a corridor the plan avoided made every move along the plan a move away; the robot crept on at
+// min_vel_x for 10-20 s, until move_base declared an oscillation.
+constexpr double kLocalGoalAhead_m = 2.0;
 // [rad] Within this of the plan kTurnLookahead_m ahead the robot faces its way.
 constexpr double kFacingPlan_rad = 0.35;
 
@@ -303,8 +310,21 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
   reach_grid_.reset(map);
   reach_grid_.markWithinRobot(robot);
   reach_grid_.setSources(map, robot);
+  // No farther than kLocalGoalAhead_m along the plan from its point nearest the robot.
+  std::size_t ahead = dense_plan_.size();
+  if (!dense_plan_.empty()) {
+    std::size_t nearest = 0;
+    for (std::size_t i = 1; i < dense_plan_.size(); ++i) {
+      if ((dense_plan_[i] - pose.head<2>()).squaredNorm() < (dense_plan_[nearest] - pose.head<2>()).squaredNorm()) nearest = i;
+    }
+    double along = 0.0;
+    for (ahead = nearest + 1; ahead < dense_plan_.size(); ++ahead) {
+      along += (dense_plan_[ahead] - dense_plan_[ahead - 1]).norm();
+      if (along > kLocalGoalAhead_m) break;
+    }
+  }
   std::size_t reachable = dense_plan_.size();
-  for (std::size_t i = dense_plan_.size(); i-- > 0;) {
+  for (std::size_t i = ahead; i-- > 0;) {
     if (reach_grid_.at(map.worldToCell(dense_plan_[i])) < reach_grid_.obstacle()) {
       reachable = i;
       break;

@@ -438,6 +438,25 @@ TEST(LocalPlanner, APlanThroughAWallOnlyTheLocalCostmapSeesStillGivesACommand) {
   EXPECT_LE(lp.localGoal().x(), 3.5 - 0.2 + 1e-9) << "the local goal lies before the wall and its inscribed band";
 }
 
+TEST(LocalPlanner, FollowsAPlanThatTurnsBackAtSpeedNotTowardsItsFarEnd) {
+  // The plan goes 2 m east, 1 m north and 2 m back west, round what the local costmap does not
+  // show (costs the global planner weighed, a way it knows to be shut). ROS's local goal is the
+  // plan's last point in the local costmap, 1 m north of the robot: every move east along the plan
+  // is a move away from it, and the robot crept on at min_vel_x. The local goal lies at most 2 m
+  // along the plan, and the robot drives east at speed.
+  Costmap m(100, 100, 0.05, {0, 0});
+  LocalPlanner lp(tutorialParams(), circleFootprint(0.2));
+  std::vector<Eigen::Vector2d> plan = straightPlan({1.0, 2.0}, {3.0, 2.0});
+  for (const auto& p : straightPlan({3.0, 2.05}, {3.0, 3.0})) plan.push_back(p);
+  for (const auto& p : straightPlan({2.95, 3.0}, {1.0, 3.0})) plan.push_back(p);
+  lp.setPlan(plan);
+  const Trajectory t = lp.findBestPath(m, {1.0, 2.0, 0.0}, {0.05, 0, 0});
+  ASSERT_GE(t.cost, 0.0);
+  EXPECT_GT(t.xv, 0.8 * 0.3);
+  EXPECT_NEAR(lp.localGoal().x(), 3.0, 0.1);
+  EXPECT_NEAR(lp.localGoal().y(), 2.0, 0.1);
+}
+
 TEST(LocalPlanner, FacingThePlanWithNoRoomAheadItBacksUpInsteadOfTurning) {
   // The robot stands facing its plan with an obstacle just beyond its footprint: no forward move
   // fits, every turn on the spot does (a round robot). ROS turns, and then may not turn back (its
