@@ -195,7 +195,9 @@ class NavigationFaultsTest(unittest.TestCase):
         # A person of the default 0.25 m: the laser sees only the near side, the goal cell looks free,
         # and driving round the person resets oscillation_timeout. progress_timeout (60 s, the
         # launch file's default) runs the recoveries, and when they are used up (by it or by the
-        # oscillation rule, whichever fires) the goal is aborted with the reason.
+        # oscillation rule, whichever fires) the goal is aborted with the reason. Where the robot
+        # has seen enough of the person to shut every way to the goal cell, the reason is that no
+        # path avoids the obstacles (on a loaded machine, 1 run in 4).
         spawn = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)
         delete = rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)
         goal = (-1.5, -3.3)
@@ -211,7 +213,8 @@ class NavigationFaultsTest(unittest.TestCase):
             state, text = self.result(900.0)
             rospy.loginfo('with a broad person on the goal: %s', text)
             self.assertEqual(state, GoalStatus.ABORTED, text)
-            self.assertTrue(any(w in text for w in ('no progress towards the goal', 'oscillating', 'is in an obstacle')),
+            self.assertTrue(any(w in text for w in ('no progress towards the goal', 'oscillating', 'is in an obstacle',
+                                                    'avoids the obstacles')),
                             text)
             with self.lock:
                 truth = self.truth
