@@ -197,7 +197,7 @@ class NavigationFaultsTest(unittest.TestCase):
         # launch file's default) runs the recoveries, and when they are used up (by it or by the
         # oscillation rule, whichever fires) the goal is aborted with the reason. Where the robot
         # has seen enough of the person to shut every way to the goal cell, the reason is that no
-        # path avoids the obstacles (on a loaded machine, 1 run in 4).
+        # path avoids the obstacles (beside a busy process, 1 run in 3).
         spawn = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)
         delete = rospy.ServiceProxy('/gazebo/delete_model', DeleteModel)
         goal = (-1.5, -3.3)
