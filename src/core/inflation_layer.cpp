@@ -257,9 +257,6 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
       rows[y - read.y0].push_back({x, boxed, base.obstacleBounds({x, y}, cell_box::kMargin)});
     }
   }
-  auto squaredDistance = [](const Eigen::Vector4d& rect, const Eigen::Vector2d& at) {
-    return cell_box::squaredDistance(rect, at.x(), at.y());
-  };
   const double spread = res / 3.0 * std::sqrt(2.0);  // [m] from a cell's centre to its farthest sample point
   std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (centre distance [m], rectangle)
   for (int y = win.y0; y < win.y1; ++y) {
@@ -275,7 +272,7 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
         const std::vector<Obstacle>& row = rows[cy - read.y0];
         auto it = std::lower_bound(row.begin(), row.end(), x - reach, [](const Obstacle& a, int v) { return a.x < v; });
         for (; it != row.end() && it->x <= x + reach; ++it) {
-          const double d = std::sqrt(squaredDistance(it->rect, centre));
+          const double d = std::sqrt(cell_box::squaredDistance(it->rect, centre.x(), centre.y()));
           boxed = boxed || it->boxed;
           nearest = std::min(nearest, d);
           near.emplace_back(d, &it->rect);
@@ -293,7 +290,7 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
           const Eigen::Vector2d at = centre + Eigen::Vector2d(sx, sy) * (res / 3.0);
           double d2 = std::numeric_limits<double>::infinity();
           for (const auto& [d, rect] : near) {
-            if (d <= keep) d2 = std::min(d2, squaredDistance(*rect, at));
+            if (d <= keep) d2 = std::min(d2, cell_box::squaredDistance(*rect, at.x(), at.y()));
           }
           best = std::max(best, d2);
         }

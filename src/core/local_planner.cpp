@@ -312,13 +312,10 @@ void LocalPlanner::updateGrids(const Costmap& map, const Eigen::Vector3d& pose) 
   reach_grid_.setSources(map, robot);
   // No farther than kLocalGoalAhead_m along the plan from its point nearest the robot.
   std::size_t ahead = dense_plan_.size();
-  if (!dense_plan_.empty()) {
-    std::size_t nearest = 0;
-    for (std::size_t i = 1; i < dense_plan_.size(); ++i) {
-      if ((dense_plan_[i] - pose.head<2>()).squaredNorm() < (dense_plan_[nearest] - pose.head<2>()).squaredNorm()) nearest = i;
-    }
+  const int nearest = nearestPlanIndex(pose.head<2>(), std::numeric_limits<double>::infinity());
+  if (nearest >= 0) {
     double along = 0.0;
-    for (ahead = nearest + 1; ahead < dense_plan_.size(); ++ahead) {
+    for (ahead = static_cast<std::size_t>(nearest) + 1; ahead < dense_plan_.size(); ++ahead) {
       along += (dense_plan_[ahead] - dense_plan_[ahead - 1]).norm();
       if (along > kLocalGoalAhead_m) break;
     }

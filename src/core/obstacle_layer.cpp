@@ -62,16 +62,17 @@ int updateWithScan(Costmap& layer, const Eigen::Vector3d& sensor_pose, const Las
       // by the laser's noise, and a beam ending just past a cell border must not erase the cell
       // in front of it that the previous scan's returns marked (the surface would flicker between
       // the two cells, a gap one cell wider and narrower from scan to scan).
+      // (With a margin of 0 the cell the beam stops short in is the end point's: costmap_2d's rule.)
       const double short_r = is_return ? r - params.raytrace_end_margin : r;
-      const bool stop_short = short_r < params.raytrace_range;
+      const bool stop_short = is_return && short_r < params.raytrace_range;
       const double clear_r = std::min(short_r, params.raytrace_range);
-      const Cell clear_end = layer.worldToCell(origin + std::max(0.0, clear_r) * dir);
       // A whole cell, box or not: a beam that misses a small box is no proof the obstacle stayed,
       // and a person's marks must go when the person does (docs/experiments.md).
       if (clear_r > 0.0) {
+        const Cell clear_end = layer.worldToCell(origin + clear_r * dir);
         walkLine(from, clear_end, [&](const Cell& c) {
           if (!layer.contains(c)) return false;
-          if (is_return && (c == end || (stop_short && params.raytrace_end_margin > 0.0 && c == clear_end))) return false;
+          if (is_return && (c == end || (stop_short && c == clear_end))) return false;
           layer.setCost(c, cost::kFree);
           return true;
         });

@@ -165,7 +165,7 @@ TEST_P(BothPlanners, ARoomyWayIsTakenOnlyWhenItIsNotMuchLonger) {
   ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
   EXPECT_TRUE(throughGap(closed, plan));
   EXPECT_EQ(used, cost::kInscribed);
-  // Nothing tight on an open floor: one search, the roomy rule's.
+  // Nothing tight on an open floor: the roomy way.
   const Costmap open(40, 60, 0.1, {0, 0});
   plan = planPreferringRoom(planner, open, start, goal, 220, cost::kInscribed, 0.5, &used);
   ASSERT_EQ(plan.status, PlanStatus::kOk) << plan.message;
