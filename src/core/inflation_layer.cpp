@@ -241,60 +241,108 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
   const uint8_t band_cost = inflatedCost(band, params);
   const uint8_t* in = base.costs().data();
   uint8_t* o = out.costs().data();
-  // The lethal cells within reach of the window, row by row in x order, as world rectangles [m].
+  // The lethal cells within reach of the window, row by row in x order, as world rectangles [m],
+  // and how many of them have boxes in each rectangle of cells from the window's corner (a summed
+  // area table: whether a cell has a box within reach is one lookup).
   struct Obstacle {
     int x;
-    bool boxed;
     Eigen::Vector4d rect;
   };
   const CellWindow read = win.grown(reach, base.width(), base.height());
-  std::vector<std::vector<Obstacle>> rows(static_cast<std::size_t>(read.y1 - read.y0));
+  const int rw = read.x1 - read.x0, rh = read.y1 - read.y0;
+  std::vector<std::vector<Obstacle>> rows(static_cast<std::size_t>(rh));
+  std::vector<int> boxed_sum(static_cast<std::size_t>(rw + 1) * (rh + 1), 0);
+  const auto sum_at = [&](int x, int y) -> int& { return boxed_sum[static_cast<std::size_t>(y) * (rw + 1) + x]; };
   for (int y = read.y0; y < read.y1; ++y) {
     const uint8_t* row = in + static_cast<std::size_t>(y) * w;
+    int in_row = 0;  // boxed lethal cells in this row left of x
     for (int x = read.x0; x < read.x1; ++x) {
-      if (row[x] != cost::kLethal) continue;
-      const bool boxed = base.box(static_cast<std::size_t>(y) * w + x) != cell_box::kNoBox;
-      rows[y - read.y0].push_back({x, boxed, base.obstacleBounds({x, y}, cell_box::kMargin)});
+      if (row[x] == cost::kLethal) {
+        in_row += base.box(static_cast<std::size_t>(y) * w + x) != cell_box::kNoBox;
+        rows[y - read.y0].push_back({x, base.obstacleBounds({x, y}, cell_box::kMargin)});
+      }
+      sum_at(x - read.x0 + 1, y - read.y0 + 1) = sum_at(x - read.x0 + 1, y - read.y0) + in_row;
     }
   }
+  // An obstacle's rectangle lies within its cell grown by kMargin: a row (column) dy cells from a
+  // cell's row is at least (|dy| - 1/2) cells less the margin from the cell's centre. Rows are
+  // searched outwards from the cell's own, each only as far as the nearest obstacle found so far
+  // allows (`keep`, below), so the obstacles that are measured are those that can matter.
+  const double slack = 1e-6;  // [m] against rounding in the bounds
+  const double inv_res = 1.0 / res;
+  const auto gap = [&](int cells) { return std::max(0.0, (cells - 0.5) * res - cell_box::kMargin); };
   const double spread = res / 3.0 * std::sqrt(2.0);  // [m] from a cell's centre to its farthest sample point
-  std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (centre distance [m], rectangle)
+  std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (squared centre distance [m^2], rectangle)
+  std::vector<Eigen::Vector4d> candidates;                      // those within `keep`
   for (int y = win.y0; y < win.y1; ++y) {
     for (int x = win.x0; x < win.x1; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       const uint8_t now = o[i];
       if (now == cost::kLethal || now < band_cost || now == cost::kNoInformation || now == cost::kFree) continue;
+      // Only whole cells within reach: inflateWindow's cost stands.
+      const int sx0 = std::max(read.x0, x - reach) - read.x0, sx1 = std::min(read.x1 - 1, x + reach) - read.x0 + 1;
+      const int sy0 = std::max(read.y0, y - reach) - read.y0, sy1 = std::min(read.y1 - 1, y + reach) - read.y0 + 1;
+      if (sum_at(sx1, sy1) - sum_at(sx0, sy1) - sum_at(sx1, sy0) + sum_at(sx0, sy0) == 0) continue;
       const Eigen::Vector2d centre = base.cellCenter({x, y});
       near.clear();
-      bool boxed = false;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int cy = std::max(read.y0, y - reach); cy <= std::min(read.y1 - 1, y + reach); ++cy) {
+      // Squared distances [m^2] from the centre: to the nearest obstacle, and beyond which an
+      // obstacle cannot be the nearest to any sample point.
+      double nearest2 = std::numeric_limits<double>::infinity(), keep2 = nearest2;
+      double keep = nearest2;  // [m]
+      for (int k = 0; k <= 2 * reach; ++k) {
+        const int dy = (k + 1) / 2 * (k % 2 ? 1 : -1);  // 0, 1, -1, 2, -2, ...
+        const double gy = gap(std::abs(dy));
+        if (gy > keep + slack) break;
+        const int cy = y + dy;
+        if (cy < read.y0 || cy >= read.y1) continue;
         const std::vector<Obstacle>& row = rows[cy - read.y0];
-        auto it = std::lower_bound(row.begin(), row.end(), x - reach, [](const Obstacle& a, int v) { return a.x < v; });
-        for (; it != row.end() && it->x <= x + reach; ++it) {
-          const double d = std::sqrt(cell_box::squaredDistance(it->rect, centre.x(), centre.y()));
-          boxed = boxed || it->boxed;
-          nearest = std::min(nearest, d);
-          near.emplace_back(d, &it->rect);
+        if (row.empty()) continue;
+        int dx_max = reach;
+        if (!std::isinf(keep)) {
+          const double gx = std::sqrt(std::max(0.0, (keep + slack) * (keep + slack) - gy * gy));  // [m]
+          dx_max = std::min(reach, static_cast<int>((gx + cell_box::kMargin) * inv_res + 0.5));  // gx >= 0: truncation floors
+        }
+        auto it = std::lower_bound(row.begin(), row.end(), x - dx_max, [](const Obstacle& a, int v) { return a.x < v; });
+        for (; it != row.end() && it->x <= x + dx_max; ++it) {
+          const double d2 = cell_box::squaredDistance(it->rect, centre.x(), centre.y());
+          if (d2 < nearest2) {
+            nearest2 = d2;
+            keep = std::sqrt(nearest2) + 2.0 * spread;
+            keep2 = keep * keep;
+          }
+          if (d2 <= keep2) near.emplace_back(d2, &it->rect);
         }
       }
-      if (!boxed) continue;  // only whole cells near: inflateWindow's cost stands
       // The clearance of the best of 3 x 3 points in the cell: a plan through a gap that is open
       // only within a centimetre or two of its middle must not depend on where the cell centres
       // fall (the local planner's footprint check is made at the robot's true pose). Only the
       // obstacles that can be nearest to one of the points are measured from each.
-      const double keep = nearest + 2.0 * spread;
-      double best = 0.0;
-      for (int sy = -1; sy <= 1; ++sy) {
-        for (int sx = -1; sx <= 1; ++sx) {
-          const Eigen::Vector2d at = centre + Eigen::Vector2d(sx, sy) * (res / 3.0);
-          double d2 = std::numeric_limits<double>::infinity();
-          for (const auto& [d, rect] : near) {
-            if (d <= keep) d2 = std::min(d2, cell_box::squaredDistance(*rect, at.x(), at.y()));
-          }
-          best = std::max(best, d2);
+      candidates.clear();
+      for (const auto& [d2, rect] : near) {
+        if (d2 <= keep2) candidates.push_back(*rect);
+      }
+      // The points' x and y; a rectangle's x and y distances to them, squared, sum to the
+      // squared distances (cell_box::squaredDistance, 6 differences instead of 18).
+      double ax[3], ay[3];
+      for (int k = 0; k < 3; ++k) {
+        ax[k] = centre.x() + (k - 1) * (res / 3.0);
+        ay[k] = centre.y() + (k - 1) * (res / 3.0);
+      }
+      double d2[9];
+      std::fill(d2, d2 + 9, std::numeric_limits<double>::infinity());
+      for (const Eigen::Vector4d& rect : candidates) {
+        double ex[3], ey[3];
+        for (int k = 0; k < 3; ++k) {
+          ex[k] = std::max(std::max(rect[0] - ax[k], ax[k] - rect[2]), 0.0);
+          ey[k] = std::max(std::max(rect[1] - ay[k], ay[k] - rect[3]), 0.0);
+          ex[k] *= ex[k];
+          ey[k] *= ey[k];
+        }
+        for (int j = 0; j < 3; ++j) {
+          for (int k = 0; k < 3; ++k) d2[3 * j + k] = std::min(d2[3 * j + k], ex[k] + ey[j]);
         }
       }
+      const double best = *std::max_element(d2, d2 + 9);
       const uint8_t c = inflatedCost(std::max(std::sqrt(best) + offset, 1e-6), params);
       if (in[i] == cost::kNoInformation) {
         o[i] = (params.inflate_unknown ? c > cost::kFree : c >= cost::kInscribed) ? c : in[i];

@@ -50,7 +50,7 @@ uint32_t grow(uint32_t box, double fx, double fy);
 /// Squared distance from point (x, y) to the rectangle `rect` (min x, min y, max x, max y), in
 /// the units of both; 0 inside.
 inline double squaredDistance(const Eigen::Vector4d& rect, double x, double y) {
-  const double dx = std::max({rect[0] - x, 0.0, x - rect[2]}), dy = std::max({rect[1] - y, 0.0, y - rect[3]});
+  const double dx = std::max(std::max(rect[0] - x, x - rect[2]), 0.0), dy = std::max(std::max(rect[1] - y, y - rect[3]), 0.0);
   return dx * dx + dy * dy;
 }
 }  // namespace cell_box
