@@ -16,8 +16,9 @@ busy machine slows a trial's wall time, not the robot's simulated one.
 
 Environment: BENCH_CLUTTER_SEEDS (default 6: 18 worlds, 36 trials), BENCH_CLUTTER_LEVELS
 (wide,medium,narrow), BENCH_CLUTTER_MAPS (true,false), BENCH_CLUTTER_LIMIT (100 simulated s, as
-the issue's trials), BENCH_CLUTTER_JOBS (2). Targets (issue 57): without a map >= 95% reached within 2.2x the ideal time,
-0 collisions, median <= 1.4x the ideal; with the map 100%, median <= 1.2x.
+the issue's trials), BENCH_CLUTTER_JOBS (2), BENCH_CLUTTER_MAP_RESOLUTION (0.05 m/cell, the
+world's map with the map given). Targets (issue 57): without a map >= 95% reached within 2.2x the
+ideal time, 0 collisions, median <= 1.4x the ideal; with the map 100%, median <= 1.2x.
 """
 import concurrent.futures
 import json
@@ -38,11 +39,12 @@ sys.path.insert(0, os.path.join(ROOT, 'tools'))
 import generate_clutter  # noqa: E402
 
 
-def trial(world_yaml: str, with_map: bool, limit: float, k: int) -> dict:
+def trial(world_yaml: str, with_map: bool, limit: float, k: int, map_resolution: float) -> dict:
     tag = '%s_%s' % (os.path.basename(world_yaml)[:-5], 'map' if with_map else 'nomap')
     out = subprocess.run([sys.executable, os.path.join(HERE, 'clutter_trial.py'), world_yaml,
                           '--map', 'true' if with_map else 'false', '--port', str(PORT + k % 50),
-                          '--limit', str(limit), '--log', os.path.join(OUT, tag + '.log')],
+                          '--map-resolution', str(map_resolution), '--limit', str(limit),
+                          '--log', os.path.join(OUT, tag + '.log')],
                          capture_output=True, text=True, timeout=20 * limit + 300)
     line = next((l for l in reversed(out.stdout.splitlines()) if l.startswith('{')), None)
     if line is None:
@@ -74,6 +76,9 @@ def main() -> int:
     levels = os.environ.get('BENCH_CLUTTER_LEVELS', 'wide,medium,narrow').split(',')
     maps = [m == 'true' for m in os.environ.get('BENCH_CLUTTER_MAPS', 'true,false').split(',')]
     limit = float(os.environ.get('BENCH_CLUTTER_LIMIT', '100'))
+    map_resolution = float(os.environ.get('BENCH_CLUTTER_MAP_RESOLUTION', '0.05'))
+    if True in maps:
+        print("  the world's map at %g m/cell" % map_resolution, flush=True)
     os.makedirs(OUT, exist_ok=True)
     worlds, ideal = [], {}
     for level in levels:
@@ -91,7 +96,7 @@ def main() -> int:
     with open(os.path.join(OUT, 'trials.jsonl'), 'w') as log, concurrent.futures.ThreadPoolExecutor(jobs) as pool:
         started = {}
         for k, (level, world_yaml, with_map) in enumerate(tasks):
-            started[pool.submit(trial, world_yaml, with_map, limit, k)] = (level, with_map)
+            started[pool.submit(trial, world_yaml, with_map, limit, k, map_resolution)] = (level, with_map)
         for done in concurrent.futures.as_completed(started):
             level, with_map = started[done]
             r = done.result()

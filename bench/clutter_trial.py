@@ -31,6 +31,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('world_yaml')
     ap.add_argument('--map', choices=('true', 'false'), default='false')
+    ap.add_argument('--map-resolution', type=float, default=0.05, help="[m/cell] the world's map with --map true")
     ap.add_argument('--port', type=int, required=True)
     ap.add_argument('--limit', type=float, default=100.0, help='[s] simulated time allowed for the goal')
     ap.add_argument('--log', default=os.devnull, help="roslaunch's output")
@@ -43,7 +44,8 @@ def main(argv=None) -> int:
     wall0 = time.monotonic()
     with open(a.log, 'w') as log:
         launch = subprocess.Popen(['roslaunch', '-p', str(a.port), '--screen', 'mbot_slam_navigation',
-                                   'move_base_clutter.launch', 'world_name:=' + world, 'map:=' + a.map],
+                                   'move_base_clutter.launch', 'world_name:=' + world, 'map:=' + a.map,
+                                   'map_resolution:=%g' % a.map_resolution],
                                   stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ, ROS_MASTER_URI=uri))
     result = {'world': info['world'], 'level': info['level'], 'seed': info['seed'], 'map': a.map == 'true',
               'outcome': 'error', 'time_s': None, 'distance_m': 0.0, 'collisions': 0, 'recoveries': 0, 'why': ''}
