@@ -718,6 +718,10 @@ void LayeredCostmap::applyKeepout(const CellWindow& w) {
           if (b[x] == cost::kNoInformation || c > b[x]) {
             b[x] = c;  // Nav2's KeepoutFilter rule
             base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
+          } else if (c == cost::kLethal) {
+            // Already lethal (a laser's mark): the zone's cell is whole all the same, not the box of
+            // what the laser saw in it.
+            base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
           }
         }
       }

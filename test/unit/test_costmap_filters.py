@@ -158,3 +158,19 @@ def test_speed_limit_is_the_lowest_under_the_footprint():
     assert (limit, percent) == (30.0, True) and zone.endswith('(filter speed_filter)')
     assert lc.speed_limit_at((2.5, 2.8, 0.0))[0] == 60.0
     assert at(lc, 2.5, 2.5) == FREE  # a speed zone costs nothing
+
+
+def test_a_zones_cell_the_laser_marks_stays_whole():
+    """Something the laser sees just inside a keep-out zone does not shrink the zone's cell to the
+    box of its returns: a footprint reaching into that cell, short of the returns, is in the zone."""
+    lc = _core.LayeredCostmap(config({'filters': [KEEPOUT]}), print)
+    lc.set_map(np.zeros((100, 100), np.int8), (0.0, 0.0), 0.05)
+    lc.set_filter_mask(0, room_mask(), (0.0, 0.0), 0.05)  # the zone: x and y in [2, 3)
+    pose = (1.0, 2.525, 0.0)
+    lc.add_scan('scan', 1.0, pose, 0.1, 0.0, 0.1, 0.1, 6.0, [1.04])  # a return at (2.04, 2.525)
+    lc.update(pose)
+    m = lc.master()
+    assert at(lc, 2.04, 2.525) == LETHAL
+    # A thin footprint from x 1.80 to 2.02 along y = 2.525: 2 cm into the zone's first column.
+    footprint = [(-0.1, -0.01), (-0.1, 0.01), (0.12, 0.01), (0.12, -0.01)]
+    assert m.footprint_cost((1.9, 2.525, 0.0), footprint) < 0
