@@ -273,7 +273,6 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
   const auto gap = [&](int cells) { return std::max(0.0, (cells - 0.5) * res - cell_box::kMargin); };
   const double spread = res / 3.0 * std::sqrt(2.0);  // [m] from a cell's centre to its farthest sample point
   std::vector<std::pair<double, const Eigen::Vector4d*>> near;  // (squared centre distance [m^2], rectangle)
-  std::vector<Eigen::Vector4d> candidates;                      // those within `keep`
   for (int y = win.y0; y < win.y1; ++y) {
     for (int x = win.x0; x < win.x1; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -316,13 +315,9 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
       // The clearance of the best of 3 x 3 points in the cell: a plan through a gap that is open
       // only within a centimetre or two of its middle must not depend on where the cell centres
       // fall (the local planner's footprint check is made at the robot's true pose). Only the
-      // obstacles that can be nearest to one of the points are measured from each.
-      candidates.clear();
-      for (const auto& [d2, rect] : near) {
-        if (d2 <= keep2) candidates.push_back(*rect);
-      }
-      // The points' x and y; a rectangle's x and y distances to them, squared, sum to the
-      // squared distances (cell_box::squaredDistance, 6 differences instead of 18).
+      // obstacles that can be nearest to one of the points are measured from each. A rectangle's
+      // x and y distances to the points' x and y, squared, sum to the squared distances
+      // (cell_box::squaredDistance, 6 differences instead of 18).
       double ax[3], ay[3];
       for (int k = 0; k < 3; ++k) {
         ax[k] = centre.x() + (k - 1) * (res / 3.0);
@@ -330,7 +325,9 @@ void refineNearBoxes(const Costmap& base, Costmap& out, const CellWindow& window
       }
       double d2[9];
       std::fill(d2, d2 + 9, std::numeric_limits<double>::infinity());
-      for (const Eigen::Vector4d& rect : candidates) {
+      for (const auto& [centre_d2, r] : near) {
+        if (centre_d2 > keep2) continue;  // found before the nearest: too far after all
+        const Eigen::Vector4d& rect = *r;
         double ex[3], ey[3];
         for (int k = 0; k < 3; ++k) {
           ex[k] = std::max(std::max(rect[0] - ax[k], ax[k] - rect[2]), 0.0);
