@@ -63,6 +63,11 @@ MoveBaseConfig readMoveBaseConfig(const ParamValue& values, const std::string& n
                                 "[s] ours: how long without the path to the goal getting 0.25 m shorter before the recoveries "
                                 "run, and after the last, the goal is aborted (0: never)",
                                 0.0);
+  c.standing_touch_wait = r.number("standing_touch_wait", c.standing_touch_wait,
+                                   "[s] ours: when something comes up to the standing robot and touches its footprint (a "
+                                   "person walking past), the robot stands this long, or until it is clear, before moving out "
+                                   "(0: at once)",
+                                   0.0);
   c.recovery_behavior_enabled = r.boolean("recovery_behavior_enabled", c.recovery_behavior_enabled,
                                           "run the recovery behaviours when stuck (else abort at once)");
   c.clearing_rotation_allowed = r.boolean("clearing_rotation_allowed", c.clearing_rotation_allowed,

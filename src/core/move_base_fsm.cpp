@@ -64,6 +64,8 @@ void MoveBaseStateMachine::reset(double now) {
   trigger_ = RecoveryTrigger::kNone;
   goal_best_m_ = std::numeric_limits<double>::infinity();
   goal_progress_time_ = now;
+  touching_ = false;
+  touch_hold_until_ = -1.0;
   why_.clear();
   abort_text_.clear();
 }
@@ -174,7 +176,20 @@ std::optional<GoalOutcome> MoveBaseStateMachine::controlStep(double now, const E
     new_plan_ = false;
   }
   const ControlResult control = ports.computeVelocity(pose);
-  if (control.valid && control.footprint_scale < 1.0) {
+  // Something that comes up to a standing robot and touches it is most likely a person walking
+  // past or into it, on the way the robot would move out by: the robot stands until it has passed.
+  if (control.touching && !touching_ && control.standing && config_.standing_touch_wait > 0) {
+    touch_hold_until_ = now + config_.standing_touch_wait;
+  }
+  touching_ = control.touching;
+  const bool holding = control.touching && now < touch_hold_until_;
+  if (holding) {
+    ports.info("hold",
+               fmt("something came up to the standing robot and touches its footprint (a person walking past?); standing "
+                   "still up to standing_touch_wait %.1f s for it to pass before moving out",
+                   config_.standing_touch_wait),
+               5.0);
+  } else if (control.valid && control.footprint_scale < 1.0) {
     // Beside a wall the footprint can touch an inflated obstacle cell; moving out is routine.
     ports.info("footprint",
                fmt("the robot's footprint touches an obstacle in the local costmap where it stands; moving out with the "
@@ -182,7 +197,7 @@ std::optional<GoalOutcome> MoveBaseStateMachine::controlStep(double now, const E
                    100.0 * control.footprint_scale),
                5.0);
   }
-  if (std::isfinite(control.obstacle_inside_m)) {
+  if (!holding && std::isfinite(control.obstacle_inside_m)) {
     ports.warn("inside",
                fmt("an obstacle stands inside the robot's footprint, %.2f m from its centre (a person who walked into "
                    "it?); only moves that keep away from it",
@@ -208,7 +223,8 @@ std::optional<GoalOutcome> MoveBaseStateMachine::controlStep(double now, const E
     state_ = MoveBaseState::kClearing;
     trigger_ = RecoveryTrigger::kOscillation;
   } else if (control.valid) {
-    ports.sendVelocity(control.command);
+    if (holding) ports.stop();
+    else ports.sendVelocity(control.command);
     last_valid_control_ = now;
     if (trigger_ == RecoveryTrigger::kControlling) recovery_index_ = 0;
   } else {

@@ -203,6 +203,7 @@ bool TrajectoryController::safe(const Costmap& costmap, const Eigen::Vector3d& p
 ControlResult TrajectoryController::compute(const Costmap& costmap, const Eigen::Vector3d& pose, const Eigen::Vector3d& vel) {
   const LocalPlannerParams& p = planner_.params();
   ControlResult out;
+  out.standing = std::abs(vel.x()) < kStandingTrans && std::abs(vel.y()) < kStandingTrans && std::abs(vel.z()) < kStandingRot;
   last_trajectory_.clear();
   if (plan_.empty()) {
     out.why = "no global plan";
@@ -263,6 +264,7 @@ ControlResult TrajectoryController::compute(const Costmap& costmap, const Eigen:
   // either way.
   const double inside = planner_.lastObstacleInside();
   if (inside < inscribedRadius(planner_.footprint()) - costmap.resolution()) out.obstacle_inside_m = inside;
+  out.touching = out.footprint_scale < 1.0 || std::isfinite(inside);
   last_trajectory_ = best.points;
   if (best.cost < 0) {
     out.why = "no valid trajectory (every sampled command collides or leaves the plan)";

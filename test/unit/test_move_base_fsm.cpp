@@ -27,6 +27,9 @@ struct FakeWorld : mbot::core::MoveBasePorts {
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();
   bool pose_ok = true, current = true, plan_ok = true, control_ok = true, reached = false, blocked = false;
   double speed = 1.0;                  // how much of the command the robot achieves
+  Eigen::Vector3d command{0.3, 0.0, 0.0};  // the local planner's command when valid
+  bool touching = false;               // the footprint touches something where the robot stands
+  bool standing = true;                // the last command was a stop or zero
   std::string plan_why = "no path";
   double recovery_s = 3.0;             // [s] each recovery takes
   std::vector<std::string> recoveries_run, warnings;
@@ -60,16 +63,24 @@ struct FakeWorld : mbot::core::MoveBasePorts {
   ControlResult computeVelocity(const Eigen::Vector3d&) override {
     ControlResult c;
     c.valid = control_ok;
-    if (c.valid) c.command = Eigen::Vector3d(0.3, 0.0, 0.0);
+    if (c.valid) c.command = command;
     else c.why = "no valid trajectory";
+    c.touching = touching;
+    c.standing = standing;
+    if (touching) c.footprint_scale = 0.97;
     return c;
   }
   bool goalReached() override { return reached; }
   void sendVelocity(const Eigen::Vector3d& command) override {
     last_command = command;
+    standing = command.isZero();
     pose.x() += speed * command.x() * dt;
   }
-  void stop() override { ++stops; }
+  void stop() override {
+    ++stops;
+    last_command.setZero();
+    standing = true;
+  }
   double runRecovery(const RecoveryConfig& r) override {
     recoveries_run.push_back(r.name);
     now += recovery_s;
@@ -285,6 +296,57 @@ TEST(MoveBaseStateMachine, APlanIsBlockedByAnInscribedCellButNotNearTheRobotTheG
   EXPECT_FALSE(mbot::core::planBlocked(map, plan, Eigen::Vector2d(7.0, 2.5), 0.3)) << "already passed";
   mark(6.0, 252);
   EXPECT_FALSE(mbot::core::planBlocked(map, plan, robot, 0.3)) << "a high cost is passable";
+}
+
+TEST(MoveBaseStateMachine, SomethingThatComesUpToTheStandingRobotIsWaitedForBeforeMovingOut) {
+  // The robot stands (its plan leads nowhere it can go yet); a person walks up and touches its
+  // footprint. It stands standing_touch_wait (3 s), then moves out; if the person passes first,
+  // it goes on at once.
+  for (const double passes_after : {10.0, 1.0}) {
+    MoveBaseStateMachine fsm(defaults());
+    FakeWorld w;
+    fsm.reset(0.0);
+    w.command.setZero();
+    run(fsm, w, {50, 0, 0}, 1.0);
+    ASSERT_TRUE(w.standing);
+    w.touching = true;
+    w.command = Eigen::Vector3d(0.1, 0.0, 0.3);  // the way out
+    const double touched = w.now;
+    double moved_at = -1.0;
+    while (w.now < touched + 6.0 && moved_at < 0.0) {
+      if (w.now >= touched + passes_after) w.touching = false;
+      fsm.cycle(w.now, {50, 0, 0}, w);
+      if (!w.last_command.isZero()) moved_at = w.now;
+      w.now += w.dt;
+    }
+    const double waited = moved_at - touched;
+    if (passes_after > 3.0) {
+      EXPECT_NEAR(waited, 3.0, 0.11) << "moved out after " << waited << " s";
+    } else {
+      EXPECT_NEAR(waited, passes_after, 0.11) << "went on " << waited << " s after the touch";
+    }
+    EXPECT_EQ(fsm.state(), MoveBaseState::kControlling);
+    EXPECT_TRUE(w.recoveries_run.empty());
+  }
+}
+
+TEST(MoveBaseStateMachine, ATouchThatBeginsWhileMovingIsMovedOutOfAtOnce) {
+  // A turn swung the footprint into a wall end: the robot's own move, nothing walking. So too
+  // with standing_touch_wait 0.
+  for (const bool moving : {true, false}) {
+    MoveBaseConfig c = defaults();
+    if (!moving) c.standing_touch_wait = 0.0;
+    MoveBaseStateMachine fsm(c);
+    FakeWorld w;
+    fsm.reset(0.0);
+    if (!moving) w.command.setZero();
+    run(fsm, w, {50, 0, 0}, 1.0);
+    ASSERT_EQ(w.standing, !moving);
+    w.touching = true;
+    w.command = Eigen::Vector3d(0.1, 0.0, 0.3);
+    fsm.cycle(w.now, {50, 0, 0}, w);
+    EXPECT_EQ(w.last_command, w.command) << (moving ? "moving" : "standing_touch_wait 0");
+  }
 }
 
 }  // namespace

@@ -40,6 +40,11 @@ struct MoveBaseConfig {
   /// oscillation_timeout, driving about does not reset it (a robot circling a person who stands on
   /// its goal). 0 disables.
   double progress_timeout = 60.0;
+  /// [s] ours: when something comes up to the standing robot and touches its footprint (a person
+  /// walking past or into it), the robot stands this long, or until it is clear, before moving out
+  /// with a shrunken footprint: what touched it may walk on into the way out. A touch that begins
+  /// while the robot moves (a wall end its turn swung into) is moved out of at once. 0: at once.
+  double standing_touch_wait = 3.0;
   bool recovery_behavior_enabled = true, clearing_rotation_allowed = true, shutdown_costmaps = false;
   double conservative_reset_dist = 3.0;
   bool make_plan_clear_costmap = true, make_plan_add_unreachable_goal = true;

@@ -42,10 +42,18 @@ struct ControlResult {
   std::string why;                                    ///< why not, when !valid
   double footprint_scale = 1.0;                       ///< < 1: moving out of an obstacle the footprint touched
   double obstacle_inside_m = std::numeric_limits<double>::infinity();  ///< [m] LocalPlanner::lastObstacleInside, when more than a cell inside the outline
+  /// A lethal cell touches the footprint's outline or lies inside it where the robot stands (the
+  /// robot moves out with a shrunken footprint, or keeps away from what is inside).
+  bool touching = false;
+  /// The robot's odometry at rest (below kStandingTrans and kStandingRot).
+  bool standing = false;
 };
 
 class TrajectoryController {
  public:
+  static constexpr double kStandingTrans = 0.02;  ///< [m/s] below this (and kStandingRot) the robot stands
+  static constexpr double kStandingRot = 0.05;    ///< [rad/s]
+
   TrajectoryController(const LocalPlannerParams& params, const LocalPlannerRosParams& ros, const Footprint& footprint);
   void setPlan(const std::vector<Eigen::Vector2d>& plan, double goal_yaw);
   void reset();
