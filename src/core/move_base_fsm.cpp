@@ -64,8 +64,9 @@ void MoveBaseStateMachine::reset(double now) {
   trigger_ = RecoveryTrigger::kNone;
   goal_best_m_ = std::numeric_limits<double>::infinity();
   goal_progress_time_ = now;
-  touching_ = false;
-  touch_hold_until_ = -1.0;
+  // touching_ is the robot's, not the goal's: a touch the last goal ended in is not new to this
+  // one. A hold beyond the wait from now is from before a clock that went back (reset_simulation).
+  if (touch_hold_until_ > now + config_.standing_touch_wait) touch_hold_until_ = -1.0;
   why_.clear();
   abort_text_.clear();
 }

@@ -349,4 +349,23 @@ TEST(MoveBaseStateMachine, ATouchThatBeginsWhileMovingIsMovedOutOfAtOnce) {
   }
 }
 
+TEST(MoveBaseStateMachine, ATouchTheLastGoalEndedInIsNotNewToTheNext) {
+  // The robot reached a goal beside a wall with its footprint touching it; the next goal moves it
+  // out at once. A touch that came to it between the goals is waited for.
+  for (const bool touching_at_the_end : {true, false}) {
+    MoveBaseStateMachine fsm(defaults());
+    FakeWorld w;
+    fsm.reset(0.0);
+    w.touching = touching_at_the_end;
+    run(fsm, w, {50, 0, 0}, 1.0);
+    w.stop();  // the goal ends; the robot stands
+    w.now += 5.0;
+    w.touching = true;
+    fsm.reset(w.now);
+    fsm.cycle(w.now, {-50, 0, 0}, w);  // plans, then controls in the same cycle
+    EXPECT_EQ(w.last_command.isZero(), !touching_at_the_end)
+        << (touching_at_the_end ? "waited for its own touch" : "moved out at once from a new touch");
+  }
+}
+
 }  // namespace

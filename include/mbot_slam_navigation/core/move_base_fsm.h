@@ -107,7 +107,7 @@ class MoveBaseStateMachine {
   std::size_t recovery_index_ = 0;
   double goal_best_m_ = std::numeric_limits<double>::infinity();
   double goal_progress_time_ = 0.0;
-  bool touching_ = false;          ///< the last control step's ControlResult::touching
+  bool touching_ = false;          ///< the last control step's ControlResult::touching (kept across goals)
   double touch_hold_until_ = -1.0;  ///< [s] standing_touch_wait ends then
   std::string why_, abort_text_;
 };
