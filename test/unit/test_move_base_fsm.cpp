@@ -299,7 +299,7 @@ TEST(MoveBaseStateMachine, APlanIsBlockedByAnInscribedCellButNotNearTheRobotTheG
 }
 
 TEST(MoveBaseStateMachine, SomethingThatComesUpToTheStandingRobotIsWaitedForBeforeMovingOut) {
-  // The robot stands (its plan leads nowhere it can go yet); a person walks up and touches its
+  // The robot stands (the local planner's command is zero); a person walks up and touches its
   // footprint. It stands standing_touch_wait (3 s), then moves out; if the person passes first,
   // it goes on at once.
   for (const double passes_after : {10.0, 1.0}) {
