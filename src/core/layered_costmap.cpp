@@ -715,14 +715,10 @@ void LayeredCostmap::applyKeepout(const CellWindow& w) {
         const int x0 = std::max(begin - dx, w.x0), x1 = std::min(end - dx, w.x1);
         for (int x = x0; x < x1; ++x) {
           const uint8_t c = keepoutCost(m[x + dx]);
-          if (b[x] == cost::kNoInformation || c > b[x]) {
-            b[x] = c;  // Nav2's KeepoutFilter rule
-            base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
-          } else if (c == cost::kLethal) {
-            // Already lethal (a laser's mark): the zone's cell is whole all the same, not the box of
-            // what the laser saw in it.
-            base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
-          }
+          const bool raised = b[x] == cost::kNoInformation || c > b[x];
+          if (raised) b[x] = c;  // Nav2's KeepoutFilter rule
+          // A zone's lethal cell is whole, also where the laser marks it: not the box of its returns.
+          if (raised || c == cost::kLethal) base_.setBox(static_cast<std::size_t>(y) * base_.width() + x, cell_box::kNoBox);
         }
       }
     }

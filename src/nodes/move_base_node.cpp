@@ -666,18 +666,26 @@ class MoveBase {
       // A tf message stamped before the jump can still be handled after that clear (seen on a busy
       // machine: "only time 491.04 is in the buffer" at 52 s, the robot pose unavailable for
       // controller_patience). tf2 then refuses every newer message as older than its cache, until
-      // the clock catches up. So the robot's newest transform must never be ahead of the clock.
+      // the clock catches up. So no transform between the robot and the global frame may be ahead
+      // of the clock: each is checked on its own (one stale link, map -> odom, makes the whole
+      // chain's lookup fail as extrapolation, and would hide it).
       const auto& c = global_->config();
-      try {
-        const ros::Time newest = tf_.lookupTransform(c.global_frame, c.robot_base_frame, ros::Time(0)).header.stamp;
+      std::string child = c.robot_base_frame, parent;
+      for (int depth = 0; depth < 16 && child != c.global_frame && tf_._getParent(child, ros::Time(0), parent); ++depth) {
+        ros::Time newest;
+        try {
+          newest = tf_.lookupTransform(parent, child, ros::Time(0)).header.stamp;
+        } catch (const tf2::TransformException&) {
+          break;  // no transform yet: nothing ahead of the clock
+        }
         if (newest > now + ros::Duration(1.0)) {
           ROS_WARN("move_base: tf holds %s -> %s at %.2f s, ahead of the clock (%.2f s): a message from before the "
-                   "clock went back; the tf buffer is cleared again", c.robot_base_frame.c_str(),
-                   c.global_frame.c_str(), newest.toSec(), now.toSec());
+                   "clock went back; the tf buffer is cleared again", child.c_str(), parent.c_str(), newest.toSec(),
+                   now.toSec());
           tf_.clear();
+          break;
         }
-      } catch (const tf2::TransformException&) {
-        // no transform yet: nothing ahead of the clock
+        child = parent;
       }
     }
     clock_seen_ = now;
